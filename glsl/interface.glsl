@@ -1,0 +1,59 @@
+// Data layouts shared with the host (src/passes/gpu.rs, checked there by
+// size asserts). Binding numbers come from src/shader_interface.rs through
+// build.rs as #defines. All blocks use the scalar layout.
+#ifndef INTERFACE_GLSL
+#define INTERFACE_GLSL
+
+#extension GL_EXT_scalar_block_layout : require
+#extension GL_EXT_ray_query : require
+
+// q(p) = pᵀAp + b·p + c with A symmetric: a0=Axx a1=Ayy a2=Azz a3=Axy a4=Ayz a5=Axz,
+// b = (b0,b1,b2), c.
+struct Quadric {
+    float a[6];
+    float b[3];
+    float c;
+};
+
+struct Object {
+    Quadric base;
+    uint material;
+    uint pad;
+};
+
+struct Perturbation {
+    Quadric q;
+    float f;
+    uint pad;
+};
+
+struct Cell {
+    float lo[3];
+    float hi[3];
+    uint first;   // into the cell lists
+    uint count;
+    uint object;
+    uint pad;
+};
+
+struct Material {
+    float albedo[3];
+    float pad0;
+    float emission[3];
+    float pad1;
+};
+
+struct Light {
+    float position[3];
+    float radius;
+    float color[3];   // intensity (point) or radiance (sphere)
+    uint kind;
+};
+
+layout(set = 0, binding = BINDING_TLAS) uniform accelerationStructureEXT tlas;
+layout(set = 0, binding = BINDING_OBJECTS, scalar) readonly buffer Objects { Object objects[]; };
+layout(set = 0, binding = BINDING_CELLS, scalar) readonly buffer Cells { Cell cells[]; };
+layout(set = 0, binding = BINDING_PERTURBATIONS, scalar) readonly buffer Perturbations { Perturbation perturbations[]; };
+layout(set = 0, binding = BINDING_CELL_LISTS, scalar) readonly buffer CellLists { uint cellLists[]; };
+
+#endif

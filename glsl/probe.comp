@@ -1,0 +1,43 @@
+#version 460
+// Traces a list of world-space rays and writes the closest hit of each:
+// the GPU side of the GPU-vs-CPU geometry tests and of the ray benchmark.
+#include "intersect.glsl"
+
+layout(local_size_x = PROBE_GROUP) in;
+
+struct Ray {
+    float origin[3];
+    float tmin;
+    float dir[3];
+    float tmax;
+};
+
+struct Hit {
+    float t;
+    float normal[3];
+    uint object;
+    uint pad[3];
+};
+
+layout(set = 0, binding = BINDING_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
+layout(set = 0, binding = BINDING_HITS, scalar) writeonly buffer Hits { Hit hits[]; };
+
+layout(push_constant, scalar) uniform Push {
+    uint first;
+    uint count;
+} pc;
+
+void main() {
+    uint i = pc.first + gl_GlobalInvocationID.x;
+    if (gl_GlobalInvocationID.x >= pc.count) return;
+    Ray r = rays[i];
+    vec3 o = vec3(r.origin[0], r.origin[1], r.origin[2]);
+    vec3 d = vec3(r.dir[0], r.dir[1], r.dir[2]);
+    SceneHit h = traceScene(o, d, r.tmin, r.tmax);
+    Hit outHit;
+    outHit.t = h.t;
+    outHit.normal = float[3](h.normal.x, h.normal.y, h.normal.z);
+    outHit.object = h.object;
+    outHit.pad = uint[3](0u, 0u, 0u);
+    hits[i] = outHit;
+}

@@ -1,0 +1,233 @@
+//! Quadrics: q(p) = pᵀ A p + b·p + c with A symmetric.
+//!
+//! Sign convention (the paper leaves it open, `NOTES.md` §5): a functional
+//! object's *inside* is where its function is `>= 0`. A perturbation's support
+//! is where its quadric is `>= 0`, so a positive form factor adds material
+//! (a bump) and a negative one removes it (a dent).
+
+use glam::{DAffine3, DMat3, DVec3};
+
+use super::Aabb;
+
+/// A quadric function of position, q(p) = pᵀ A p + b·p + c.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quadric {
+    /// Symmetric quadratic part.
+    pub a: DMat3,
+    /// Linear part.
+    pub b: DVec3,
+    /// Constant part.
+    pub c: f64,
+}
+
+/// Coefficients of q(o + t d) = c0 + c1 t + c2 t², lowest degree first.
+pub type Quadratic = [f64; 3];
+
+impl Quadric {
+    /// From the ten coefficients of
+    /// `xx x² + yy y² + zz z² + xy xy + yz yz + xz xz + x x + y y + z z + k`,
+    /// in that order: `[xx, yy, zz, xy, yz, xz, x, y, z, k]`.
+    pub fn from_coefficients(k: [f64; 10]) -> Self {
+        let a = DMat3::from_cols(
+            DVec3::new(k[0], 0.5 * k[3], 0.5 * k[5]),
+            DVec3::new(0.5 * k[3], k[1], 0.5 * k[4]),
+            DVec3::new(0.5 * k[5], 0.5 * k[4], k[2]),
+        );
+        Self { a, b: DVec3::new(k[6], k[7], k[8]), c: k[9] }
+    }
+
+    /// The ten coefficients in the order of [`Quadric::from_coefficients`].
+    pub fn coefficients(&self) -> [f64; 10] {
+        let a = &self.a;
+        [
+            a.x_axis.x,
+            a.y_axis.y,
+            a.z_axis.z,
+            2.0 * a.y_axis.x,
+            2.0 * a.z_axis.y,
+            2.0 * a.z_axis.x,
+            self.b.x,
+            self.b.y,
+            self.b.z,
+            self.c,
+        ]
+    }
+
+    /// `1 - Σ ((p - centre)_k / radii_k)²`: positive inside an ellipsoid.
+    pub fn ellipsoid(centre: DVec3, radii: DVec3) -> Self {
+        let inv2 = DVec3::ONE / (radii * radii);
+        let a = DMat3::from_diagonal(-inv2);
+        let b = 2.0 * inv2 * centre;
+        let c = 1.0 - (centre * centre * inv2).element_sum();
+        Self { a, b, c }
+    }
+
+    /// Value at `p`.
+    pub fn eval(&self, p: DVec3) -> f64 {
+        p.dot(self.a * p) + self.b.dot(p) + self.c
+    }
+
+    /// Gradient at `p`: 2 A p + b.
+    pub fn gradient(&self, p: DVec3) -> DVec3 {
+        2.0 * (self.a * p) + self.b
+    }
+
+    /// The restriction to the ray o + t d, as a quadratic in t.
+    pub fn along_ray(&self, o: DVec3, d: DVec3) -> Quadratic {
+        let ad = self.a * d;
+        [self.eval(o), 2.0 * o.dot(ad) + self.b.dot(d), d.dot(ad)]
+    }
+
+    /// This quadric expressed in the coordinates `p' = m p`: q'(p') = q(m⁻¹ p').
+    pub fn transformed(&self, m: &DAffine3) -> Self {
+        let inv = m.inverse();
+        let l = inv.matrix3;
+        let t = inv.translation;
+        let a = l.transpose() * self.a * l;
+        let b = l.transpose() * (2.0 * (self.a * t) + self.b);
+        let c = self.eval(t);
+        Self { a, b, c }
+    }
+
+    /// True when every coefficient is finite.
+    pub fn is_finite(&self) -> bool {
+        self.coefficients().iter().all(|v| v.is_finite())
+    }
+
+    /// True when the function is constant (no quadratic and no linear part):
+    /// its zero set is empty or everything.
+    pub fn is_degenerate(&self) -> bool {
+        let k = self.coefficients();
+        let scale = k.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        scale == 0.0 || k[..9].iter().all(|v| v.abs() <= 1e-12 * scale)
+    }
+
+    /// Bounding box of `{q >= 0}` when that set is bounded: `Some(None)` when
+    /// it is empty, `Some(Some(box))` when bounded, `None` when unbounded.
+    ///
+    /// `{q >= 0}` is bounded only when A is negative definite; then it is the
+    /// ellipsoid (p - m)ᵀ(-A)(p - m) <= q(m) around m = -A⁻¹b/2, whose box
+    /// half-extents are sqrt(q(m) · ((-A)⁻¹)_kk).
+    pub fn support_bounds(&self) -> Option<Option<Aabb>> {
+        let neg = -self.a;
+        if !is_positive_definite(&neg) {
+            return None;
+        }
+        let inv = neg.inverse();
+        let centre = 0.5 * (inv * self.b);
+        let top = self.eval(centre);
+        if top < 0.0 {
+            return Some(None);
+        }
+        let half = DVec3::new(
+            (top * inv.x_axis.x).max(0.0).sqrt(),
+            (top * inv.y_axis.y).max(0.0).sqrt(),
+            (top * inv.z_axis.z).max(0.0).sqrt(),
+        );
+        // Widen by a few ulps so that the box is conservative after rounding.
+        let pad = (half + centre.abs()) * 1e-12;
+        Some(Some(Aabb::new(centre - half - pad, centre + half + pad)))
+    }
+
+    /// A conservative range of values over `bx` (interval arithmetic).
+    pub fn range_over(&self, bx: &Aabb) -> (f64, f64) {
+        let x = [bx.min.x, bx.max.x];
+        let y = [bx.min.y, bx.max.y];
+        let z = [bx.min.z, bx.max.z];
+        let a = &self.a;
+        let mut lo = self.c;
+        let mut hi = self.c;
+        let mut add = |(l, h): (f64, f64)| {
+            lo += l;
+            hi += h;
+        };
+        add(scale(square(x), a.x_axis.x));
+        add(scale(square(y), a.y_axis.y));
+        add(scale(square(z), a.z_axis.z));
+        add(scale(product(x, y), 2.0 * a.y_axis.x));
+        add(scale(product(y, z), 2.0 * a.z_axis.y));
+        add(scale(product(x, z), 2.0 * a.z_axis.x));
+        add(scale((x[0], x[1]), self.b.x));
+        add(scale((y[0], y[1]), self.b.y));
+        add(scale((z[0], z[1]), self.b.z));
+        (lo, hi)
+    }
+}
+
+fn is_positive_definite(m: &DMat3) -> bool {
+    // Sylvester's criterion on the leading principal minors.
+    let m1 = m.x_axis.x;
+    let m2 = m.x_axis.x * m.y_axis.y - m.y_axis.x * m.x_axis.y;
+    m1 > 0.0 && m2 > 0.0 && m.determinant() > 0.0
+}
+
+fn square(i: [f64; 2]) -> (f64, f64) {
+    let (a, b) = (i[0] * i[0], i[1] * i[1]);
+    if i[0] <= 0.0 && i[1] >= 0.0 {
+        (0.0, a.max(b))
+    } else {
+        (a.min(b), a.max(b))
+    }
+}
+
+fn product(i: [f64; 2], j: [f64; 2]) -> (f64, f64) {
+    let p = [i[0] * j[0], i[0] * j[1], i[1] * j[0], i[1] * j[1]];
+    (
+        p.iter().cloned().fold(f64::INFINITY, f64::min),
+        p.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+    )
+}
+
+fn scale((l, h): (f64, f64), s: f64) -> (f64, f64) {
+    if s >= 0.0 {
+        (l * s, h * s)
+    } else {
+        (h * s, l * s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coefficients_round_trip() {
+        let k = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0];
+        assert_eq!(Quadric::from_coefficients(k).coefficients(), k);
+    }
+
+    #[test]
+    fn transform_moves_the_zero_set() {
+        let q = Quadric::ellipsoid(DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0));
+        let m = DAffine3::from_scale_rotation_translation(
+            DVec3::new(2.0, 1.0, 0.5),
+            glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 1.1),
+            DVec3::new(5.0, -3.0, 2.0),
+        );
+        let t = q.transformed(&m);
+        for p in [DVec3::new(0.2, 0.4, -1.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0)] {
+            assert!((t.eval(m.transform_point3(p)) - q.eval(p)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn ellipsoid_support_box_is_exact() {
+        let q = Quadric::ellipsoid(DVec3::new(1.0, 2.0, 3.0), DVec3::new(0.5, 1.5, 2.5));
+        let b = q.support_bounds().unwrap().unwrap();
+        assert!((b.min - DVec3::new(0.5, 0.5, 0.5)).abs().max_element() < 1e-9);
+        assert!((b.max - DVec3::new(1.5, 3.5, 5.5)).abs().max_element() < 1e-9);
+    }
+
+    #[test]
+    fn interval_range_contains_samples() {
+        let q = Quadric::from_coefficients([1.0, -2.0, 0.5, 0.3, -0.7, 1.1, 0.2, -0.4, 0.9, -0.3]);
+        let bx = Aabb::new(DVec3::new(-1.0, 0.5, -2.0), DVec3::new(0.5, 2.0, 1.0));
+        let (lo, hi) = q.range_over(&bx);
+        for i in 0..1000 {
+            let f = |k: u32| ((i * 7919 + k * 104729) % 1000) as f64 / 999.0;
+            let p = bx.min + (bx.max - bx.min) * DVec3::new(f(1), f(2), f(3));
+            let v = q.eval(p);
+            assert!(v >= lo - 1e-12 && v <= hi + 1e-12);
+        }
+    }
+}

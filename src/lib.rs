@@ -1,0 +1,52 @@
+//! quadray: a Vulkan path tracer for functionally defined objects
+//! (perturbed quadrics), after Vyatkin & Dolgovesov 2022 (`../shared/seed/`).
+//!
+//! - [`geometry`]: the surfaces in f64 on the CPU (bounds, cells, the
+//!   reference intersection).
+//! - [`scene`]: the scene model and its TOML files.
+//! - [`vk`]: the Vulkan backend.
+//! - [`passes`]: GPU passes.
+//! - [`output`]: PNG and EXR files, written atomically.
+
+pub mod geometry;
+pub mod output;
+pub mod passes;
+pub mod scene;
+pub mod shader_interface;
+mod shaders;
+pub mod vk;
+
+/// Errors of rendering a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The Vulkan backend failed.
+    #[error(transparent)]
+    Vk(#[from] vk::VkError),
+    /// An object cannot be rendered.
+    #[error("object `{object}`: {source}")]
+    Geometry {
+        /// The object's name.
+        object: String,
+        /// What is wrong.
+        source: geometry::GeometryError,
+    },
+}
+
+impl From<ash::vk::Result> for RenderError {
+    fn from(e: ash::vk::Result) -> Self {
+        Self::Vk(e.into())
+    }
+}
+
+/// Uploads `scene` and renders it at its own image settings, reporting
+/// progress as (done, total) work units.
+pub fn render_scene(
+    ctx: &vk::Context,
+    scene: &scene::Scene,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<passes::RenderOutput, RenderError> {
+    let mut cmds = vk::Commands::new(&ctx.device)?;
+    let gpu = passes::GpuScene::new(&ctx.device, &mut cmds, scene, &geometry::CellParams::default())?;
+    let im = &scene.image;
+    passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), progress)
+}

@@ -1,0 +1,179 @@
+//! The `quadray` command line: render a scene file to PNG and EXR.
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context as _, Result};
+use clap::{Parser, Subcommand};
+use quadray::output::{write_exr, write_png, ExrPrecision};
+use quadray::scene::{load_scene, parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+
+/// A Vulkan path tracer for functionally defined objects (perturbed quadrics).
+///
+/// With no subcommand, renders the built-in default scene to render.png and render.exr.
+#[derive(Parser, Debug)]
+#[command(version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene file (or the built-in default scene) to an image.
+    Render(RenderArgs),
+}
+
+#[derive(Parser, Debug, Default)]
+struct RenderArgs {
+    /// Scene file (TOML, see scenes/README.md). Omit it to render the built-in default scene.
+    scene: Option<PathBuf>,
+    /// Output path. `NAME.png` writes only a PNG, `NAME.exr` only an EXR, a
+    /// name without one of those extensions writes both `NAME.png` and `NAME.exr`.
+    #[arg(short, long, default_value = "render")]
+    output: PathBuf,
+    /// Samples per pixel (overrides the scene's `image.spp`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: Option<u32>,
+    /// Image width in pixels (overrides `image.width`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Image height in pixels (overrides `image.height`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Random seed (overrides `image.seed`).
+    #[arg(long)]
+    seed: Option<u32>,
+    /// Write the EXR with 16-bit half floats instead of 32-bit floats.
+    #[arg(long)]
+    half: bool,
+    /// Enable the Khronos validation layer; the command fails if it reports errors.
+    #[arg(long, env = "QUADRAY_VALIDATION")]
+    validation: bool,
+    /// Print progress even when stderr is not a terminal.
+    #[arg(long)]
+    progress: bool,
+}
+
+/// Which files `-o` asks for.
+fn output_paths(output: &Path) -> Vec<PathBuf> {
+    match output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+        Some(e) if e == "png" || e == "exr" => vec![output.to_path_buf()],
+        _ => {
+            let mut png = output.as_os_str().to_owned();
+            png.push(".png");
+            let mut exr = output.as_os_str().to_owned();
+            exr.push(".exr");
+            vec![PathBuf::from(png), PathBuf::from(exr)]
+        }
+    }
+}
+
+/// A progress line on stderr, shown once a render has run for a second.
+struct ProgressLine {
+    start: Instant,
+    enabled: bool,
+    shown: bool,
+}
+
+impl ProgressLine {
+    fn new(force: bool) -> Self {
+        Self { start: Instant::now(), enabled: force || std::io::stderr().is_terminal(), shown: false }
+    }
+
+    fn update(&mut self, done: u64, total: u64) {
+        let elapsed = self.start.elapsed().as_secs_f64();
+        if !self.enabled || elapsed < 1.0 || total == 0 {
+            return;
+        }
+        let frac = done as f64 / total as f64;
+        let eta = if frac > 0.0 { elapsed * (1.0 - frac) / frac } else { 0.0 };
+        let width = 30;
+        let filled = (frac * width as f64) as usize;
+        eprint!(
+            "\r[{}{}] {:5.1}%  {:.1}s elapsed, {:.1}s left ",
+            "#".repeat(filled),
+            " ".repeat(width - filled),
+            100.0 * frac,
+            elapsed,
+            eta
+        );
+        let _ = std::io::stderr().flush();
+        self.shown = true;
+    }
+
+    fn finish(&self) {
+        if self.shown {
+            eprintln!();
+        }
+    }
+}
+
+fn load(args: &RenderArgs) -> Result<Scene> {
+    let mut scene = match &args.scene {
+        Some(path) => load_scene(path)?,
+        None => parse_scene(DEFAULT_SCENE, DEFAULT_SCENE_NAME)?,
+    };
+    if let Some(spp) = args.spp {
+        scene.image.spp = spp;
+    }
+    if let Some(w) = args.width {
+        scene.image.width = w;
+    }
+    if let Some(h) = args.height {
+        scene.image.height = h;
+    }
+    if let Some(s) = args.seed {
+        scene.image.seed = s;
+    }
+    Ok(scene)
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    let scene = load(&args)?;
+    let outputs = output_paths(&args.output);
+    for p in &outputs {
+        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if !dir.is_dir() {
+                bail!("output directory {} does not exist", dir.display());
+            }
+        }
+    }
+    let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
+    let counters = ctx.counters();
+    let mut progress = ProgressLine::new(args.progress);
+    let out = quadray::render_scene(&ctx, &scene, &mut |d, t| progress.update(d, t));
+    progress.finish();
+    let out = out.context("render failed")?;
+    let precision = if args.half { ExrPrecision::Half } else { ExrPrecision::Float };
+    for p in &outputs {
+        let is_png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let written = if is_png { write_png(&out, scene.image.exposure, p) } else { write_exr(&out, precision, p) };
+        written.with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
+    eprintln!(
+        "wrote {} ({}x{}, {} spp, {:.2} s on {})",
+        names.join(", "),
+        out.width,
+        out.height,
+        out.spp,
+        out.seconds,
+        ctx.device.name
+    );
+    drop(ctx);
+    if counters.errors() > 0 {
+        bail!("the validation layer reported {} error(s)", counters.errors());
+    }
+    Ok(())
+}
+
+fn main() -> Result<()> {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    match cli.command {
+        Some(Command::Render(args)) => render(args),
+        None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),
+    }
+}

@@ -1,0 +1,202 @@
+//! Host mirrors of the shader structs in `glsl/interface.glsl` (scalar
+//! layout), with compile-time size checks.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::geometry::Quadric;
+
+/// `Quadric` in interface.glsl: A's six entries, b, c.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuQuadric {
+    /// Axx, Ayy, Azz, Axy, Ayz, Axz.
+    pub a: [f32; 6],
+    /// Linear part.
+    pub b: [f32; 3],
+    /// Constant.
+    pub c: f32,
+}
+
+impl From<&Quadric> for GpuQuadric {
+    fn from(q: &Quadric) -> Self {
+        let a = &q.a;
+        Self {
+            a: [a.x_axis.x, a.y_axis.y, a.z_axis.z, a.y_axis.x, a.z_axis.y, a.z_axis.x].map(|v| v as f32),
+            b: q.b.to_array().map(|v| v as f32),
+            c: q.c as f32,
+        }
+    }
+}
+
+/// `Object` in interface.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuObject {
+    /// Base quadric in the object frame.
+    pub base: GpuQuadric,
+    /// Material index.
+    pub material: u32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// `Perturbation` in interface.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuPerturbation {
+    /// Perturbing quadric in the object frame.
+    pub q: GpuQuadric,
+    /// Form factor.
+    pub f: f32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// `Cell` in interface.glsl: one procedural AABB.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuCell {
+    /// Box minimum (object frame).
+    pub lo: [f32; 3],
+    /// Box maximum.
+    pub hi: [f32; 3],
+    /// First entry in the cell lists.
+    pub first: u32,
+    /// Number of perturbations.
+    pub count: u32,
+    /// Object index.
+    pub object: u32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// `Material` in interface.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Albedo.
+    pub albedo: [f32; 3],
+    /// Padding.
+    pub pad0: f32,
+    /// Emitted radiance.
+    pub emission: [f32; 3],
+    /// Padding.
+    pub pad1: f32,
+}
+
+/// `Light` in interface.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Position or centre.
+    pub position: [f32; 3],
+    /// Radius (sphere lights).
+    pub radius: f32,
+    /// Intensity (point) or radiance (sphere).
+    pub color: [f32; 3],
+    /// `LIGHT_POINT` or `LIGHT_SPHERE`.
+    pub kind: u32,
+}
+
+/// `Frame` in render.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuFrame {
+    /// Camera position.
+    pub eye: [f32; 3],
+    /// View direction (unit).
+    pub forward: [f32; 3],
+    /// Right vector scaled by tan(fov/2) · aspect.
+    pub right: [f32; 3],
+    /// Up vector scaled by tan(fov/2).
+    pub up: [f32; 3],
+    /// Background radiance.
+    pub background: [f32; 3],
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Random seed.
+    pub seed: u32,
+    /// Number of lights.
+    pub light_count: u32,
+}
+
+/// `Aov` in render.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuAov {
+    /// Distance along the normalised pixel-centre ray (infinity on a miss).
+    pub depth: f32,
+    /// World-space outward normal (zero on a miss).
+    pub normal: [f32; 3],
+    /// Material albedo (zero on a miss).
+    pub albedo: [f32; 3],
+}
+
+/// `Ray` in probe.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuRay {
+    /// Origin.
+    pub origin: [f32; 3],
+    /// Parameter range start.
+    pub tmin: f32,
+    /// Direction.
+    pub dir: [f32; 3],
+    /// Parameter range end.
+    pub tmax: f32,
+}
+
+/// `Hit` in probe.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuHit {
+    /// Ray parameter of the closest hit (3.4e38 on a miss).
+    pub t: f32,
+    /// World-space outward unit normal.
+    pub normal: [f32; 3],
+    /// Object index, or `NO_HIT`.
+    pub object: u32,
+    /// Padding.
+    pub pad: [u32; 3],
+}
+
+/// Push constants of render.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct RenderPush {
+    /// First pixel of the tile.
+    pub tile_origin: [u32; 2],
+    /// Tile size in pixels.
+    pub tile_size: [u32; 2],
+    /// Sample number (seeds the random sequence).
+    pub sample_index: u32,
+    /// 1 to write the AOVs in this dispatch.
+    pub write_aov: u32,
+}
+
+/// Push constants of probe.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct ProbePush {
+    /// First ray of the dispatch.
+    pub first: u32,
+    /// Number of rays.
+    pub count: u32,
+}
+
+const _: () = {
+    assert!(std::mem::size_of::<GpuQuadric>() == 40);
+    assert!(std::mem::size_of::<GpuObject>() == 48);
+    assert!(std::mem::size_of::<GpuPerturbation>() == 48);
+    assert!(std::mem::size_of::<GpuCell>() == 40);
+    assert!(std::mem::size_of::<GpuMaterial>() == 32);
+    assert!(std::mem::size_of::<GpuLight>() == 32);
+    assert!(std::mem::size_of::<GpuFrame>() == 76);
+    assert!(std::mem::size_of::<GpuAov>() == 28);
+    assert!(std::mem::size_of::<GpuRay>() == 32);
+    assert!(std::mem::size_of::<GpuHit>() == 32);
+    assert!(std::mem::size_of::<RenderPush>() == 24);
+    assert!(std::mem::size_of::<ProbePush>() == 8);
+};

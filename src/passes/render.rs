@@ -1,0 +1,135 @@
+//! The render pass: for every sample and every tile, one dispatch that traces
+//! camera rays and lights the first hit directly (render.comp). Tiles keep
+//! each submission short; progress is reported after each.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::gpu::{GpuAov, GpuFrame, RenderPush};
+use super::scene_gpu::{camera_basis, GpuScene};
+use crate::scene::Scene;
+use crate::shader_interface::RENDER_GROUP;
+use crate::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::{shaders, RenderError};
+
+/// Pixels per tile side: a tile is one dispatch of one sample.
+const TILE: u32 = 256;
+
+/// What a render produces: linear radiance and AOVs, row 0 at the top.
+pub struct RenderOutput {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Mean radiance per pixel (linear RGB).
+    pub radiance: Vec<[f32; 3]>,
+    /// Depth, normal and albedo per pixel from the pixel-centre ray.
+    pub aov: Vec<GpuAov>,
+    /// Samples per pixel taken.
+    pub spp: u32,
+    /// Wall time of the GPU work in seconds.
+    pub seconds: f64,
+}
+
+/// Progress of a render: (work done, total work), in tile-samples.
+pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
+
+/// Renders `scene` at `width` x `height` with `spp` samples per pixel.
+pub fn render(
+    device: &Arc<Device>,
+    cmds: &mut Commands,
+    gpu: &GpuScene,
+    scene: &Scene,
+    (width, height, spp): (u32, u32, u32),
+    progress: Progress<'_>,
+) -> Result<RenderOutput, RenderError> {
+    let pixels = width as u64 * height as u64;
+    let [eye, forward, right, up] = camera_basis(scene, width, height);
+    let frame = GpuFrame {
+        eye: eye.as_vec3().to_array(),
+        forward: forward.as_vec3().to_array(),
+        right: right.as_vec3().to_array(),
+        up: up.as_vec3().to_array(),
+        background: scene.background.to_array(),
+        width,
+        height,
+        seed: scene.image.seed,
+        light_count: gpu.light_count,
+    };
+    let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
+    let mut accum = Buffer::new(
+        device,
+        "accumulation",
+        pixels * 16,
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        MemoryLocation::GpuToCpu,
+    )?;
+    accum.write(0, &vec![0u8; (pixels * 16) as usize]);
+    let aov = Buffer::new(
+        device,
+        "aov",
+        pixels * std::mem::size_of::<GpuAov>() as u64,
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        MemoryLocation::GpuToCpu,
+    )?;
+
+    let mut kinds = vec![BindingKind::AccelerationStructure];
+    kinds.extend([BindingKind::StorageBuffer; 9]);
+    let pipeline =
+        ComputePipeline::new(device, &shaders::render(), &kinds, std::mem::size_of::<RenderPush>() as u32, &[])?;
+    let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
+    pipeline.bind(&[
+        tlas,
+        objects,
+        cells,
+        perturbations,
+        lists,
+        Binding::Buffer(&gpu.materials),
+        Binding::Buffer(&gpu.lights),
+        Binding::Buffer(&frame_buf),
+        Binding::Buffer(&accum),
+        Binding::Buffer(&aov),
+    ]);
+
+    let tiles: Vec<[u32; 4]> = (0..height)
+        .step_by(TILE as usize)
+        .flat_map(|y| {
+            (0..width).step_by(TILE as usize).map(move |x| [x, y, TILE.min(width - x), TILE.min(height - y)])
+        })
+        .collect();
+    let total = tiles.len() as u64 * spp as u64;
+    let start = Instant::now();
+    let mut done = 0;
+    for sample in 0..spp {
+        for t in &tiles {
+            let push = RenderPush {
+                tile_origin: [t[0], t[1]],
+                tile_size: [t[2], t[3]],
+                sample_index: sample,
+                write_aov: (sample == 0) as u32,
+            };
+            cmds.run(|_, cmd| {
+                pipeline.dispatch(
+                    cmd,
+                    bytemuck::bytes_of(&push),
+                    [t[2].div_ceil(RENDER_GROUP), t[3].div_ceil(RENDER_GROUP), 1],
+                )
+            })?;
+            done += 1;
+            progress(done, total);
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+
+    let sums: Vec<[f32; 4]> = accum.read();
+    let radiance = sums[..pixels as usize]
+        .iter()
+        .map(|s| {
+            let n = s[3].max(1.0);
+            [s[0] / n, s[1] / n, s[2] / n]
+        })
+        .collect();
+    let mut aovs: Vec<GpuAov> = aov.read();
+    aovs.truncate(pixels as usize);
+    Ok(RenderOutput { width, height, radiance, aov: aovs, spp, seconds })
+}

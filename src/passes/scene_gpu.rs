@@ -1,0 +1,211 @@
+//! A scene on the GPU: object, cell and perturbation tables, one bottom-level
+//! acceleration structure of procedural AABBs per object (one AABB per cell)
+//! and a top level with each object's transform.
+
+use std::sync::Arc;
+
+use glam::{DAffine3, DVec3};
+
+use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation, GpuQuadric};
+use crate::geometry::{Aabb, CellParams};
+use crate::scene::{Light, Scene};
+use crate::shader_interface::{LIGHT_POINT, LIGHT_SPHERE};
+use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device};
+use crate::RenderError;
+
+/// Sizes of what a scene put on the GPU.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GeometryStats {
+    /// Number of perturbations.
+    pub perturbations: usize,
+    /// Number of cells (procedural AABBs).
+    pub cells: usize,
+    /// Number of entries in the per-cell perturbation lists.
+    pub cell_list_entries: usize,
+    /// Bytes of the perturbation, cell and cell-list tables.
+    pub table_bytes: u64,
+    /// Bytes of the acceleration structures (bottom and top levels).
+    pub accel_bytes: u64,
+}
+
+/// A scene uploaded to the GPU.
+pub struct GpuScene {
+    /// Top-level acceleration structure.
+    pub tlas: AccelerationStructure,
+    _blases: Vec<AccelerationStructure>,
+    /// Object table.
+    pub objects: Buffer,
+    /// Cell table.
+    pub cells: Buffer,
+    /// Perturbation table.
+    pub perturbations: Buffer,
+    /// Per-cell perturbation lists.
+    pub cell_lists: Buffer,
+    /// Materials.
+    pub materials: Buffer,
+    /// Lights.
+    pub lights: Buffer,
+    /// Number of lights.
+    pub light_count: u32,
+    /// Sizes.
+    pub stats: GeometryStats,
+}
+
+/// Rounds a box outward to f32.
+fn f32_box(b: &Aabb) -> ([f32; 3], [f32; 3]) {
+    let lo = b.min.to_array().map(|v| {
+        let f = v as f32;
+        if f as f64 > v {
+            f.next_down()
+        } else {
+            f
+        }
+    });
+    let hi = b.max.to_array().map(|v| {
+        let f = v as f32;
+        if (f as f64) < v {
+            f.next_up()
+        } else {
+            f
+        }
+    });
+    (lo, hi)
+}
+
+/// Row-major 3x4 matrix of an affine transform.
+fn row_major_3x4(m: &DAffine3) -> [f32; 12] {
+    let c = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation];
+    let mut out = [0.0f32; 12];
+    for r in 0..3 {
+        for (k, col) in c.iter().enumerate() {
+            out[r * 4 + k] = col[r] as f32;
+        }
+    }
+    out
+}
+
+fn storage(device: &Arc<Device>, name: &str, bytes: &[u8]) -> Result<Buffer, RenderError> {
+    Ok(Buffer::with_data(device, name, bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?)
+}
+
+impl GpuScene {
+    /// Splits every object into cells and uploads the scene.
+    pub fn new(device: &Arc<Device>, cmds: &mut Commands, scene: &Scene, params: &CellParams) -> Result<Self, RenderError> {
+        let mut objects = Vec::new();
+        let mut cells: Vec<GpuCell> = Vec::new();
+        let mut perturbations: Vec<GpuPerturbation> = Vec::new();
+        let mut lists: Vec<u32> = Vec::new();
+        let mut blases = Vec::new();
+        let mut placements = Vec::new();
+
+        for (index, object) in scene.objects.iter().enumerate() {
+            let object_cells = object
+                .shape
+                .cells(params)
+                .map_err(|source| RenderError::Geometry { object: object.name.clone(), source })?;
+            let first_perturbation = perturbations.len() as u32;
+            perturbations.extend(
+                object
+                    .shape
+                    .perturbations
+                    .iter()
+                    .map(|p| GpuPerturbation { q: GpuQuadric::from(&p.quadric), f: p.form_factor as f32, pad: 0 }),
+            );
+            objects.push(GpuObject { base: GpuQuadric::from(&object.shape.base), material: object.material as u32, pad: 0 });
+            if object_cells.is_empty() {
+                continue;
+            }
+            let first_cell = cells.len() as u32;
+            let mut aabbs = Vec::with_capacity(object_cells.len());
+            for c in &object_cells {
+                let (lo, hi) = f32_box(&c.bounds);
+                aabbs.push([lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]);
+                cells.push(GpuCell {
+                    lo,
+                    hi,
+                    first: lists.len() as u32,
+                    count: c.perturbations.len() as u32,
+                    object: index as u32,
+                    pad: 0,
+                });
+                lists.extend(c.perturbations.iter().map(|&i| first_perturbation + i));
+            }
+            blases.push(AccelerationStructure::bottom_level_aabbs(device, cmds, &aabbs)?);
+            placements.push((blases.len() - 1, object.transform, first_cell));
+        }
+
+        let instances: Vec<AsInstance<'_>> = placements
+            .iter()
+            .map(|&(b, t, first_cell)| AsInstance { blas: &blases[b], transform: row_major_3x4(&t), custom_index: first_cell })
+            .collect();
+        let tlas = AccelerationStructure::top_level(device, cmds, &instances)?;
+
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| GpuMaterial { albedo: m.albedo.to_array(), pad0: 0.0, emission: m.emission.to_array(), pad1: 0.0 })
+            .collect();
+        let lights: Vec<GpuLight> = scene
+            .lights
+            .iter()
+            .map(|l| match l {
+                Light::Point { position, intensity } => GpuLight {
+                    position: position.as_vec3().to_array(),
+                    radius: 0.0,
+                    color: intensity.to_array(),
+                    kind: LIGHT_POINT,
+                },
+                Light::Sphere { centre, radius, radiance } => GpuLight {
+                    position: centre.as_vec3().to_array(),
+                    radius: *radius as f32,
+                    color: radiance.to_array(),
+                    kind: LIGHT_SPHERE,
+                },
+            })
+            .collect();
+
+        let stats = GeometryStats {
+            perturbations: perturbations.len(),
+            cells: cells.len(),
+            cell_list_entries: lists.len(),
+            table_bytes: (std::mem::size_of_val(perturbations.as_slice())
+                + std::mem::size_of_val(cells.as_slice())
+                + std::mem::size_of_val(lists.as_slice())) as u64,
+            accel_bytes: blases.iter().map(|b| b.buffer.size).sum::<u64>() + tlas.buffer.size,
+        };
+        Ok(Self {
+            objects: storage(device, "objects", bytemuck::cast_slice(&objects))?,
+            cells: storage(device, "cells", bytemuck::cast_slice(&cells))?,
+            perturbations: storage(device, "perturbations", bytemuck::cast_slice(&perturbations))?,
+            cell_lists: storage(device, "cell lists", bytemuck::cast_slice(&lists))?,
+            materials: storage(device, "materials", bytemuck::cast_slice(&materials))?,
+            light_count: lights.len() as u32,
+            lights: storage(device, "lights", bytemuck::cast_slice(&lights))?,
+            tlas,
+            _blases: blases,
+            stats,
+        })
+    }
+
+    /// The bindings `BINDING_TLAS..=BINDING_CELL_LISTS` shared by all passes.
+    pub fn geometry_bindings(&self) -> [Binding<'_>; 5] {
+        [
+            Binding::AccelerationStructure(&self.tlas),
+            Binding::Buffer(&self.objects),
+            Binding::Buffer(&self.cells),
+            Binding::Buffer(&self.perturbations),
+            Binding::Buffer(&self.cell_lists),
+        ]
+    }
+}
+
+/// The camera basis of a scene for an image of the given size.
+pub fn camera_basis(scene: &Scene, width: u32, height: u32) -> [DVec3; 4] {
+    let c = &scene.camera;
+    let forward = (c.look_at - c.position).normalize();
+    let right = forward.cross(c.up).normalize();
+    let up = right.cross(forward);
+    let half = (0.5 * c.vfov_degrees.to_radians()).tan();
+    let aspect = width as f64 / height as f64;
+    [c.position, forward, right * half * aspect, up * half]
+}

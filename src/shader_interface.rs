@@ -1,0 +1,39 @@
+// Constants shared by the host and the shaders. build.rs includes this file
+// and passes every `pub const NAME: u32 = VALUE;` line to glslang as a
+// `#define NAME VALUE`, so bindings and enums are defined once.
+// Only such constant lines belong here.
+
+/// Descriptor binding of the top-level acceleration structure.
+pub const BINDING_TLAS: u32 = 0;
+/// Descriptor binding of the object table.
+pub const BINDING_OBJECTS: u32 = 1;
+/// Descriptor binding of the cell table (one entry per procedural AABB).
+pub const BINDING_CELLS: u32 = 2;
+/// Descriptor binding of the perturbation table.
+pub const BINDING_PERTURBATIONS: u32 = 3;
+/// Descriptor binding of the per-cell perturbation index lists.
+pub const BINDING_CELL_LISTS: u32 = 4;
+/// Descriptor binding of the materials.
+pub const BINDING_MATERIALS: u32 = 5;
+/// Descriptor binding of the lights.
+pub const BINDING_LIGHTS: u32 = 6;
+/// Descriptor binding of the per-frame parameters (render pass).
+pub const BINDING_FRAME: u32 = 7;
+/// Descriptor binding of the radiance accumulation buffer (render pass).
+pub const BINDING_ACCUM: u32 = 8;
+/// Descriptor binding of the AOV buffer (render pass).
+pub const BINDING_AOV: u32 = 9;
+/// Descriptor binding of the input rays (probe pass).
+pub const BINDING_RAYS: u32 = 5;
+/// Descriptor binding of the output hits (probe pass).
+pub const BINDING_HITS: u32 = 6;
+/// Workgroup width and height of the render pass.
+pub const RENDER_GROUP: u32 = 8;
+/// Workgroup size of the probe pass.
+pub const PROBE_GROUP: u32 = 64;
+/// Light kind: point light.
+pub const LIGHT_POINT: u32 = 0;
+/// Light kind: sphere light.
+pub const LIGHT_SPHERE: u32 = 1;
+/// Object index written for a ray that hits nothing.
+pub const NO_HIT: u32 = 4294967295;

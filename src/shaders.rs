@@ -1,0 +1,17 @@
+//! SPIR-V of the compute shaders, compiled from `glsl/` by build.rs.
+
+/// Converts embedded SPIR-V bytes to words (copying: `include_bytes!` gives
+/// no alignment guarantee).
+fn words(bytes: &[u8]) -> Vec<u32> {
+    bytemuck::pod_collect_to_vec(bytes)
+}
+
+/// `glsl/render.comp`: camera rays and direct lighting.
+pub fn render() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/render.comp.spv")))
+}
+
+/// `glsl/probe.comp`: closest hits of a list of rays.
+pub fn probe() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/probe.comp.spv")))
+}

@@ -1,0 +1,103 @@
+//! Buffers that own their memory.
+
+use std::sync::Arc;
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+use super::{Device, VkError};
+
+/// A buffer and its memory, freed on drop.
+pub struct Buffer {
+    device: Arc<Device>,
+    /// The buffer handle.
+    pub raw: vk::Buffer,
+    allocation: Option<Allocation>,
+    /// Size in bytes.
+    pub size: u64,
+}
+
+impl Buffer {
+    /// Creates a buffer of `size` bytes (at least 4) in `location`.
+    pub fn new(
+        device: &Arc<Device>,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Self, VkError> {
+        let size = size.max(4);
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(usage | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let raw = unsafe { device.raw.create_buffer(&info, None) }?;
+        let requirements = unsafe { device.raw.get_buffer_memory_requirements(raw) };
+        let allocation = device.allocator.lock().expect("allocator lock").allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { device.raw.destroy_buffer(raw, None) };
+                return Err(VkError::Allocation(format!("{name}: {e}")));
+            }
+        };
+        if let Err(e) = unsafe { device.raw.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) } {
+            let _ = device.allocator.lock().expect("allocator lock").free(allocation);
+            unsafe { device.raw.destroy_buffer(raw, None) };
+            return Err(e.into());
+        }
+        Ok(Self { device: device.clone(), raw, allocation: Some(allocation), size })
+    }
+
+    /// A host-visible buffer holding `data`.
+    pub fn with_data<T: bytemuck::Pod>(
+        device: &Arc<Device>,
+        name: &str,
+        data: &[T],
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Self, VkError> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let mut b = Self::new(device, name, bytes.len() as u64, usage, MemoryLocation::CpuToGpu)?;
+        b.write(0, bytes);
+        Ok(b)
+    }
+
+    /// The buffer's device address.
+    pub fn device_address(&self) -> vk::DeviceAddress {
+        let info = vk::BufferDeviceAddressInfo::default().buffer(self.raw);
+        unsafe { self.device.raw.get_buffer_device_address(&info) }
+    }
+
+    fn mapped(&self) -> &[u8] {
+        self.allocation.as_ref().and_then(|a| a.mapped_slice()).expect("buffer is not host visible")
+    }
+
+    /// Copies `bytes` into the (host-visible) buffer at `offset`.
+    pub fn write(&mut self, offset: usize, bytes: &[u8]) {
+        let slice = self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).expect("buffer is not host visible");
+        slice[offset..offset + bytes.len()].copy_from_slice(bytes);
+    }
+
+    /// Reads the (host-visible) buffer as a vector of `T`.
+    pub fn read<T: bytemuck::Pod>(&self) -> Vec<T> {
+        let bytes = self.mapped();
+        let n = bytes.len() / std::mem::size_of::<T>();
+        bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<T>()])
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        if let Some(a) = self.allocation.take() {
+            let _ = self.device.allocator.lock().map(|mut al| al.free(a));
+        }
+        unsafe { self.device.raw.destroy_buffer(self.raw, None) };
+    }
+}

@@ -1,0 +1,91 @@
+//! Recording and submitting command buffers, waiting on a fence.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{Device, VkError};
+
+/// One reusable command buffer with its pool and fence.
+pub struct Commands {
+    device: Arc<Device>,
+    pool: vk::CommandPool,
+    /// The command buffer.
+    pub cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+impl Commands {
+    /// Creates a command pool, one primary command buffer and a fence.
+    pub fn new(device: &Arc<Device>) -> Result<Self, VkError> {
+        let raw = &device.raw;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(device.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let pool = unsafe { raw.create_command_pool(&pool_info, None) }?;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let cmd = match unsafe { raw.allocate_command_buffers(&alloc) } {
+            Ok(c) => c[0],
+            Err(e) => {
+                unsafe { raw.destroy_command_pool(pool, None) };
+                return Err(e.into());
+            }
+        };
+        let fence = match unsafe { raw.create_fence(&vk::FenceCreateInfo::default(), None) } {
+            Ok(f) => f,
+            Err(e) => {
+                unsafe { raw.destroy_command_pool(pool, None) };
+                return Err(e.into());
+            }
+        };
+        Ok(Self { device: device.clone(), pool, cmd, fence })
+    }
+
+    /// Records commands with `record`, submits them and waits until done.
+    pub fn run<R>(&mut self, record: impl FnOnce(&ash::Device, vk::CommandBuffer) -> R) -> Result<R, VkError> {
+        let raw = &self.device.raw;
+        unsafe {
+            raw.reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())?;
+            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            raw.begin_command_buffer(self.cmd, &begin)?;
+            let out = record(raw, self.cmd);
+            raw.end_command_buffer(self.cmd)?;
+            let cmds = [self.cmd];
+            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+            raw.reset_fences(&[self.fence])?;
+            raw.queue_submit(self.device.queue, &submit, self.fence)?;
+            raw.wait_for_fences(&[self.fence], true, u64::MAX)?;
+            Ok(out)
+        }
+    }
+}
+
+/// A full memory barrier between compute/transfer/acceleration-structure work.
+pub fn full_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let access = vk::AccessFlags::SHADER_READ
+        | vk::AccessFlags::SHADER_WRITE
+        | vk::AccessFlags::TRANSFER_READ
+        | vk::AccessFlags::TRANSFER_WRITE
+        | vk::AccessFlags::ACCELERATION_STRUCTURE_READ_KHR
+        | vk::AccessFlags::ACCELERATION_STRUCTURE_WRITE_KHR;
+    let barrier = vk::MemoryBarrier::default().src_access_mask(access).dst_access_mask(access);
+    let stages = vk::PipelineStageFlags::COMPUTE_SHADER
+        | vk::PipelineStageFlags::TRANSFER
+        | vk::PipelineStageFlags::ACCELERATION_STRUCTURE_BUILD_KHR;
+    unsafe {
+        device.cmd_pipeline_barrier(cmd, stages, stages, vk::DependencyFlags::empty(), &[barrier], &[], &[]);
+    }
+}
+
+impl Drop for Commands {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.raw.device_wait_idle();
+            self.device.raw.destroy_fence(self.fence, None);
+            self.device.raw.destroy_command_pool(self.pool, None);
+        }
+    }
+}

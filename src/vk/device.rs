@@ -1,0 +1,216 @@
+//! Physical-device choice and the logical device, with its queue, memory
+//! allocator and the ray-query extensions.
+
+use std::ffi::CStr;
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex};
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+
+use super::{Instance, VkError};
+
+/// The device extensions the renderer cannot work without.
+const REQUIRED_EXTENSIONS: [&CStr; 3] = [
+    ash::khr::acceleration_structure::NAME,
+    ash::khr::ray_query::NAME,
+    ash::khr::deferred_host_operations::NAME,
+];
+
+/// The command that installs a driver with ray queries.
+pub const SETUP_HINT: &str =
+    "run `make setup` (installs Mesa's lavapipe with VK_KHR_ray_query from bookworm-backports on Debian 12)";
+
+/// A logical device with one compute queue and a memory allocator.
+pub struct Device {
+    /// The instance (kept alive as long as the device).
+    pub instance: Arc<Instance>,
+    /// The physical device.
+    pub physical: vk::PhysicalDevice,
+    /// The logical device.
+    pub raw: ash::Device,
+    /// Queue family of [`Device::queue`].
+    pub queue_family: u32,
+    /// A queue with compute support.
+    pub queue: vk::Queue,
+    /// VK_KHR_acceleration_structure entry points.
+    pub accel: ash::khr::acceleration_structure::Device,
+    /// Device properties.
+    pub properties: vk::PhysicalDeviceProperties,
+    /// Acceleration-structure limits.
+    pub accel_properties: AccelProperties,
+    /// Device name, for messages.
+    pub name: String,
+    /// The memory allocator (dropped before the device).
+    pub allocator: ManuallyDrop<Mutex<Allocator>>,
+}
+
+/// The acceleration-structure limits the renderer uses.
+#[derive(Clone, Copy, Debug)]
+pub struct AccelProperties {
+    /// Alignment of scratch buffer addresses.
+    pub min_scratch_offset_alignment: u32,
+}
+
+/// What one physical device lacks for the renderer; empty when it fits.
+fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String> {
+    let mut missing = Vec::new();
+    let props = unsafe { instance.get_physical_device_properties(pd) };
+    if props.api_version < vk::API_VERSION_1_2 {
+        missing.push("Vulkan 1.2".to_string());
+    }
+    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    for req in REQUIRED_EXTENSIONS {
+        if !exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == req).unwrap_or(false)) {
+            missing.push(req.to_string_lossy().into_owned());
+        }
+    }
+    if missing.is_empty() {
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+        let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+        let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
+        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12).push_next(&mut fas).push_next(&mut frq);
+        unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+        if f12.buffer_device_address == 0 {
+            missing.push("bufferDeviceAddress".into());
+        }
+        if f12.scalar_block_layout == 0 {
+            missing.push("scalarBlockLayout".into());
+        }
+        if fas.acceleration_structure == 0 {
+            missing.push("accelerationStructure".into());
+        }
+        if frq.ray_query == 0 {
+            missing.push("rayQuery".into());
+        }
+    }
+    let has_compute = unsafe { instance.get_physical_device_queue_family_properties(pd) }
+        .iter()
+        .any(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE));
+    if !has_compute {
+        missing.push("a compute queue".into());
+    }
+    missing
+}
+
+fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
+    props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_else(|_| "?".into())
+}
+
+impl Device {
+    /// Picks the first physical device with ray queries (preferring discrete
+    /// GPUs, then integrated, then software) and creates a logical device.
+    /// When none fits, the error lists every device seen and what it lacks.
+    pub fn new(instance: Arc<Instance>) -> Result<Arc<Self>, VkError> {
+        let raw_instance = &instance.raw;
+        let devices = unsafe { raw_instance.enumerate_physical_devices() }?;
+        let mut report = Vec::new();
+        let mut fits = Vec::new();
+        for &pd in &devices {
+            let props = unsafe { raw_instance.get_physical_device_properties(pd) };
+            let missing = shortcomings(raw_instance, pd);
+            let name = device_name(&props);
+            if missing.is_empty() {
+                let rank = match props.device_type {
+                    vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+                    vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+                    vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+                    _ => 3,
+                };
+                fits.push((rank, pd));
+                report.push(format!("  {name}: suitable"));
+            } else {
+                report.push(format!("  {name}: lacks {}", missing.join(", ")));
+            }
+        }
+        let Some(&(_, physical)) = fits.iter().min_by_key(|(rank, _)| *rank) else {
+            let seen = if report.is_empty() { "  (no Vulkan devices)".to_string() } else { report.join("\n") };
+            return Err(VkError::NoSuitableDevice(format!("devices seen:\n{seen}\nTo fix: {SETUP_HINT}")));
+        };
+        Self::create(instance.clone(), physical)
+    }
+
+    fn create(instance: Arc<Instance>, physical: vk::PhysicalDevice) -> Result<Arc<Self>, VkError> {
+        let raw_instance = &instance.raw;
+        let properties = unsafe { raw_instance.get_physical_device_properties(physical) };
+        let queue_family = unsafe { raw_instance.get_physical_device_queue_family_properties(physical) }
+            .iter()
+            .position(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE))
+            .expect("checked in shortcomings") as u32;
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let ext_names: Vec<_> = REQUIRED_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
+
+        let mut supported12 = vk::PhysicalDeviceVulkan12Features::default();
+        let mut supported = vk::PhysicalDeviceFeatures2::default().push_next(&mut supported12);
+        unsafe { raw_instance.get_physical_device_features2(physical, &mut supported) };
+        let base_features = vk::PhysicalDeviceFeatures::default()
+            .shader_float64(supported.features.shader_float64 == vk::TRUE)
+            .shader_int64(supported.features.shader_int64 == vk::TRUE);
+
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
+            .buffer_device_address(true)
+            .scalar_block_layout(true)
+            .host_query_reset(supported12.host_query_reset == vk::TRUE);
+        let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
+        let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
+        let mut features = vk::PhysicalDeviceFeatures2::default()
+            .features(base_features)
+            .push_next(&mut f12)
+            .push_next(&mut fas)
+            .push_next(&mut frq);
+        let info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_extension_names(&ext_names)
+            .push_next(&mut features);
+        let raw = unsafe { raw_instance.create_device(physical, &info, None) }?;
+        let queue = unsafe { raw.get_device_queue(queue_family, 0) };
+        let accel = ash::khr::acceleration_structure::Device::new(raw_instance, &raw);
+
+        let mut as_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut as_props);
+        unsafe { raw_instance.get_physical_device_properties2(physical, &mut props2) };
+        let accel_properties =
+            AccelProperties { min_scratch_offset_alignment: as_props.min_acceleration_structure_scratch_offset_alignment };
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: raw_instance.clone(),
+            device: raw.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: true,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| VkError::Allocation(e.to_string()))?;
+
+        let name = device_name(&properties);
+        log::info!("Vulkan device: {name}");
+        Ok(Arc::new(Self {
+            instance,
+            physical,
+            raw,
+            queue_family,
+            queue,
+            accel,
+            properties,
+            accel_properties,
+            name,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+        }))
+    }
+
+    /// Nanoseconds per timestamp tick.
+    pub fn timestamp_period_ns(&self) -> f64 {
+        self.properties.limits.timestamp_period as f64
+    }
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.raw.device_wait_idle();
+            ManuallyDrop::drop(&mut self.allocator);
+            self.raw.destroy_device(None);
+        }
+    }
+}

@@ -1,0 +1,155 @@
+//! The Vulkan instance, with the Khronos validation layer and a debug
+//! messenger that routes messages to `log` and counts errors.
+
+use std::ffi::{c_void, CStr};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::VkError;
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// Counts of validation messages by severity, shared with the messenger
+/// callback and readable after the instance is gone (leaks are reported
+/// when the device is destroyed).
+#[derive(Debug, Default)]
+pub struct ValidationCounters {
+    errors: AtomicUsize,
+    warnings: AtomicUsize,
+}
+
+impl ValidationCounters {
+    /// Messages of error severity seen so far.
+    pub fn errors(&self) -> usize {
+        self.errors.load(Ordering::SeqCst)
+    }
+
+    /// Messages of warning severity seen so far.
+    pub fn warnings(&self) -> usize {
+        self.warnings.load(Ordering::SeqCst)
+    }
+}
+
+/// A Vulkan instance that owns its debug messenger.
+pub struct Instance {
+    /// The loader entry points.
+    pub entry: ash::Entry,
+    /// The instance.
+    pub raw: ash::Instance,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    counters: Arc<ValidationCounters>,
+    // Keeps the callback's user data alive as long as the messenger.
+    _callback_data: Box<Arc<ValidationCounters>>,
+}
+
+impl Instance {
+    /// Creates a Vulkan 1.2 instance; with `validation`, enables the Khronos
+    /// validation layer (failing if it is not installed) and a messenger.
+    pub fn new(validation: bool) -> Result<Self, VkError> {
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))?;
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"quadray")
+            .engine_name(c"quadray")
+            .api_version(vk::API_VERSION_1_2);
+
+        let mut layers = Vec::new();
+        let mut extensions = Vec::new();
+        if validation {
+            let available = unsafe { entry.enumerate_instance_layer_properties() }?;
+            let found = available
+                .iter()
+                .any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
+            if !found {
+                return Err(VkError::MissingValidationLayer);
+            }
+            layers.push(VALIDATION_LAYER.as_ptr());
+            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+
+        let counters = Arc::new(ValidationCounters::default());
+        let callback_data = Box::new(counters.clone());
+        let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::INFO,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(&*callback_data as *const Arc<ValidationCounters> as *mut c_void);
+
+        let mut info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions);
+        if validation {
+            // Also report problems in vkCreateInstance / vkDestroyInstance.
+            info = info.push_next(&mut messenger_info);
+        }
+        let raw = unsafe { entry.create_instance(&info, None) }?;
+
+        let debug = if validation {
+            let loader = ash::ext::debug_utils::Instance::new(&entry, &raw);
+            let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }?;
+            Some((loader, messenger))
+        } else {
+            None
+        };
+        Ok(Self { entry, raw, debug, counters, _callback_data: callback_data })
+    }
+
+    /// The validation message counters (shared; outlive the instance).
+    pub fn counters(&self) -> Arc<ValidationCounters> {
+        self.counters.clone()
+    }
+
+    /// True when the validation layer is on.
+    pub fn validation_enabled(&self) -> bool {
+        self.debug.is_some()
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        unsafe {
+            if let Some((loader, messenger)) = self.debug.take() {
+                loader.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.raw.destroy_instance(None);
+        }
+    }
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    let message = if data.is_null() || (*data).p_message.is_null() {
+        std::borrow::Cow::Borrowed("(no message)")
+    } else {
+        CStr::from_ptr((*data).p_message).to_string_lossy()
+    };
+    let counters = (user as *const Arc<ValidationCounters>).as_ref();
+    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        if let Some(c) = counters {
+            c.errors.fetch_add(1, Ordering::SeqCst);
+        }
+        log::error!(target: "vulkan", "[{kind:?}] {message}");
+    } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+        if let Some(c) = counters {
+            c.warnings.fetch_add(1, Ordering::SeqCst);
+        }
+        log::warn!(target: "vulkan", "[{kind:?}] {message}");
+    } else {
+        log::debug!(target: "vulkan", "[{kind:?}] {message}");
+    }
+    vk::FALSE
+}

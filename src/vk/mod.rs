@@ -1,0 +1,67 @@
+//! The Vulkan backend: one concept a file, each object owning its cleanup.
+//!
+//! `Context` is the entry point: instance (with validation when asked) and a
+//! device with ray queries, created headless.
+
+mod accel;
+mod buffer;
+mod commands;
+mod device;
+mod instance;
+mod pipeline;
+mod timestamps;
+
+use std::sync::Arc;
+
+pub use accel::{AccelerationStructure, Instance as AsInstance};
+pub use ash::vk;
+pub use buffer::Buffer;
+pub use commands::{full_barrier, Commands};
+pub use device::{Device, SETUP_HINT};
+pub use gpu_allocator::MemoryLocation;
+pub use instance::{Instance, ValidationCounters};
+pub use pipeline::{Binding, BindingKind, ComputePipeline};
+pub use timestamps::Timestamps;
+
+/// Errors from the Vulkan backend.
+#[derive(Debug, thiserror::Error)]
+pub enum VkError {
+    /// The Vulkan loader library could not be loaded.
+    #[error("cannot load the Vulkan loader (libvulkan.so.1): {0}. To fix: {SETUP_HINT}")]
+    Loader(String),
+    /// Validation was asked for but the layer is not installed.
+    #[error("the Khronos validation layer is not installed (package vulkan-validationlayers). To fix: {SETUP_HINT}")]
+    MissingValidationLayer,
+    /// No device has what the renderer needs.
+    #[error("no Vulkan device supports ray queries; {0}")]
+    NoSuitableDevice(String),
+    /// Memory allocation failed.
+    #[error("GPU memory allocation failed: {0}")]
+    Allocation(String),
+    /// A Vulkan call failed.
+    #[error("Vulkan call failed: {0}")]
+    Vk(#[from] vk::Result),
+}
+
+/// An instance and a device, ready for work.
+pub struct Context {
+    /// The device (holds the instance).
+    pub device: Arc<Device>,
+    counters: Arc<ValidationCounters>,
+}
+
+impl Context {
+    /// Creates a headless context. `validation` turns on the Khronos layer.
+    pub fn new(validation: bool) -> Result<Self, VkError> {
+        let instance = Arc::new(Instance::new(validation)?);
+        let counters = instance.counters();
+        let device = Device::new(instance)?;
+        Ok(Self { device, counters })
+    }
+
+    /// Validation message counters; they stay readable after the context
+    /// is dropped, when the layer reports leaked objects.
+    pub fn counters(&self) -> Arc<ValidationCounters> {
+        self.counters.clone()
+    }
+}
