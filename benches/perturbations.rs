@@ -1,1 +1,102 @@
-fn main() {}
+//! Ray throughput against a unit sphere carrying 0, 10, 100 and 1000 small
+//! perturbations spread over it, measured in one run on the same device and
+//! reported as time ratios to the unperturbed sphere, with the GPU memory
+//! each perturbation costs.
+//!
+//! `cargo bench --bench perturbations` (add `-- --rays N` to change the ray
+//! count). GPU time comes from timestamps around the probe dispatches; the
+//! first run of each configuration is discarded (lavapipe compiles the
+//! shader at its first dispatch), the median of the next runs is kept.
+
+use std::sync::Arc;
+
+use glam::{DAffine3, DVec3, Vec3};
+use quadray::geometry::{scatter::spread_bumps, CellParams, FunctionalObject, Quadric};
+use quadray::passes::gpu::GpuRay;
+use quadray::passes::{GpuScene, ProbePass};
+use quadray::scene::{Camera, ImageSettings, Material, Scene, SceneObject};
+use quadray::shader_interface::NO_HIT;
+use quadray::vk::{Commands, Context};
+
+const COUNTS: [usize; 4] = [0, 10, 100, 1000];
+const BUMP_RADIUS: f64 = 0.05;
+const FORM_FACTOR: f64 = 0.05;
+const RUNS: usize = 7;
+
+fn sphere_scene(n: usize) -> Scene {
+    let shape = FunctionalObject {
+        base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE),
+        perturbations: spread_bumps(n, DVec3::ONE, BUMP_RADIUS, FORM_FACTOR, true),
+        clip: None,
+    };
+    Scene {
+        image: ImageSettings { width: 1, height: 1, spp: 1, seed: 0, exposure: 0.0 },
+        camera: Camera { position: DVec3::new(0.0, 0.0, 4.0), look_at: DVec3::ZERO, up: DVec3::Y, vfov_degrees: 40.0 },
+        background: Vec3::ZERO,
+        materials: vec![Material { name: "grey".into(), albedo: Vec3::splat(0.8), emission: Vec3::ZERO }],
+        objects: vec![SceneObject { name: format!("sphere with {n} bumps"), shape, transform: DAffine3::IDENTITY, material: 0 }],
+        lights: vec![],
+    }
+}
+
+/// A `side` x `side` grid of parallel-projection rays over the sphere's
+/// silhouette square, from z = 4 toward -z.
+fn grid_rays(side: usize) -> Vec<GpuRay> {
+    (0..side * side)
+        .map(|i| {
+            let x = -1.1 + 2.2 * ((i % side) as f32 + 0.5) / side as f32;
+            let y = -1.1 + 2.2 * ((i / side) as f32 + 0.5) / side as f32;
+            GpuRay { origin: [x, y, 4.0], tmin: 0.0, dir: [0.0, 0.0, -1.0], tmax: 1e30 }
+        })
+        .collect()
+}
+
+fn main() {
+    let mut side = 1024;
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--rays") {
+        let n: usize = args.get(i + 1).and_then(|v| v.parse().ok()).expect("--rays N");
+        side = (n as f64).sqrt().ceil() as usize;
+    }
+    let ctx = Context::new(false).expect("a Vulkan device with ray queries (run `make setup`)");
+    let device = Arc::clone(&ctx.device);
+    let mut cmds = Commands::new(&device).unwrap();
+    let rays = grid_rays(side);
+    println!("device: {}; {} rays per run, median of {} runs after a discarded first run\n", device.name, rays.len(), RUNS);
+    println!(
+        "{:>13} {:>6} {:>8} {:>10} {:>12} {:>10} {:>14} {:>16}",
+        "perturbations", "cells", "hit %", "ms", "Mrays/s", "time ratio", "table B/pert", "accel B (total)"
+    );
+    let mut base_ms = None;
+    let mut base_table = 0u64;
+    for n in COUNTS {
+        let scene = sphere_scene(n);
+        let gpu = GpuScene::new(&device, &mut cmds, &scene, &CellParams::default()).unwrap();
+        let probe = ProbePass::new(&device, &gpu, &rays).unwrap();
+        let (hits, _) = probe.run(&mut cmds).unwrap();
+        let hit_fraction = hits.iter().filter(|h| h.object != NO_HIT).count() as f64 / hits.len() as f64;
+        let mut times: Vec<f64> = (0..RUNS).map(|_| probe.run(&mut cmds).unwrap().1 * 1e-6).collect();
+        times.sort_by(f64::total_cmp);
+        let ms = times[RUNS / 2];
+        let base = *base_ms.get_or_insert(ms);
+        let stats = gpu.stats;
+        if n == 0 {
+            base_table = stats.table_bytes;
+        }
+        let per_pert = if n > 0 { format!("{:.1}", (stats.table_bytes - base_table) as f64 / n as f64) } else { "-".into() };
+        println!(
+            "{:>13} {:>6} {:>8.1} {:>10.2} {:>12.2} {:>10.2} {:>14} {:>16}",
+            n,
+            stats.cells,
+            100.0 * hit_fraction,
+            ms,
+            rays.len() as f64 / (ms * 1e3),
+            ms / base,
+            per_pert,
+            stats.accel_bytes
+        );
+    }
+    println!("\ntime ratio: GPU time / GPU time with 0 perturbations (target: <= 3 at 1000).");
+    println!("table B/pert: bytes of perturbation, cell and cell-list tables added per perturbation (target: <= 64),");
+    println!("              acceleration structures listed separately.");
+}

@@ -68,11 +68,13 @@ float cellFirstRoot(uint cellIndex, vec3 o, vec3 d, float tlo, float thi) {
     float t1 = min(min(min(tmx.x, tmx.y), tmx.z), thi);
     if (!(t0 <= t1)) return NO_ROOT;
 
-    // Expand around the segment's middle for conditioning: s = t - tc.
+    // Breakpoints are found in s = t - tc around the segment's middle; each
+    // piece's polynomial is expanded around the piece's own middle, so that
+    // its coefficients stay well conditioned in f32.
     float tc = 0.5 * (t0 + t1);
     vec3 p = o + tc * d;
     float s1 = t1 - tc;
-    vec3 base = quadricAlongRay(objects[cell.object].base, p, d);
+    Quadric baseQ = objects[cell.object].base;
 
     float sa = t0 - tc;
     for (uint piece = 0; piece <= 2u * cell.count && sa < s1; ++piece) {
@@ -84,14 +86,16 @@ float cellFirstRoot(uint cellIndex, vec3 o, vec3 d, float tlo, float thi) {
             if (r.y > sa && r.y < sb) sb = r.y;
         }
         float sm = 0.5 * (sa + sb);
+        vec3 pm = p + sm * d;
+        vec3 base = quadricAlongRay(baseQ, pm, d);
         float c[7] = float[7](base.x, base.y, base.z, 0.0, 0.0, 0.0, 0.0);
         for (uint i = 0; i < cell.count; ++i) {
             Perturbation pt = perturbations[cellLists[cell.first + i]];
-            vec3 q = quadricAlongRay(pt.q, p, d);
-            if (q.x + sm * (q.y + sm * q.z) > 0.0) addCube(c, q, pt.f);
+            vec3 q = quadricAlongRay(pt.q, pm, d);
+            if (q.x > 0.0) addCube(c, q, pt.f);
         }
-        float r = firstRoot(c, sa, sb);
-        if (r != NO_ROOT) return tc + r;
+        float r = firstRoot(c, sa - sm, sb - sm);
+        if (r != NO_ROOT) return tc + sm + r;
         sa = sb;
     }
     return NO_ROOT;

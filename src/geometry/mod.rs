@@ -7,6 +7,7 @@ pub mod object;
 pub mod poly;
 pub mod quadric;
 pub mod reference;
+pub mod scatter;
 
 pub use object::{Cell, CellParams, FunctionalObject, GeometryError, Perturbation};
 pub use quadric::Quadric;

@@ -129,29 +129,46 @@ impl Quadric {
         Some(Some(Aabb::new(centre - half - pad, centre + half + pad)))
     }
 
-    /// A conservative range of values over `bx` (interval arithmetic).
+    /// A conservative range of values over `bx`.
+    ///
+    /// Centred form around the box's middle m: q(m + h) = q(m) + Σ_i (g_i h_i
+    /// + A_ii h_i²) + Σ_{i<j} 2 A_ij h_i h_j with g = ∇q(m). Each one-axis
+    /// term is bounded exactly on [-e_i, e_i]; the cross terms by
+    /// ±2|A_ij| e_i e_j. The range is exact for quadrics without cross terms
+    /// (ellipsoids, spheres, axis-aligned cylinders, planes), and far
+    /// tighter than interval arithmetic on the expanded form for boxes away
+    /// from the origin.
     pub fn range_over(&self, bx: &Aabb) -> (f64, f64) {
-        let x = [bx.min.x, bx.max.x];
-        let y = [bx.min.y, bx.max.y];
-        let z = [bx.min.z, bx.max.z];
+        let m = bx.centre();
+        let e = 0.5 * bx.size();
+        let g = self.gradient(m);
         let a = &self.a;
-        let mut lo = self.c;
-        let mut hi = self.c;
-        let mut add = |(l, h): (f64, f64)| {
+        let diag = [a.x_axis.x, a.y_axis.y, a.z_axis.z];
+        let mut lo = self.eval(m);
+        let mut hi = lo;
+        for i in 0..3 {
+            let (l, h) = quadratic_range(g[i], diag[i], e[i]);
             lo += l;
             hi += h;
-        };
-        add(scale(square(x), a.x_axis.x));
-        add(scale(square(y), a.y_axis.y));
-        add(scale(square(z), a.z_axis.z));
-        add(scale(product(x, y), 2.0 * a.y_axis.x));
-        add(scale(product(y, z), 2.0 * a.z_axis.y));
-        add(scale(product(x, z), 2.0 * a.z_axis.x));
-        add(scale((x[0], x[1]), self.b.x));
-        add(scale((y[0], y[1]), self.b.y));
-        add(scale((z[0], z[1]), self.b.z));
-        (lo, hi)
+        }
+        let cross = 2.0 * (a.y_axis.x.abs() * e.x * e.y + a.z_axis.y.abs() * e.y * e.z + a.z_axis.x.abs() * e.x * e.z);
+        (lo - cross, hi + cross)
     }
+}
+
+/// Exact range of g h + a h² for h in [-e, e].
+fn quadratic_range(g: f64, a: f64, e: f64) -> (f64, f64) {
+    let v = |h: f64| h * (g + a * h);
+    let (v0, v1) = (v(-e), v(e));
+    let (mut lo, mut hi) = (v0.min(v1), v0.max(v1));
+    if a != 0.0 {
+        let h = -g / (2.0 * a);
+        if h.abs() < e {
+            lo = lo.min(v(h));
+            hi = hi.max(v(h));
+        }
+    }
+    (lo, hi)
 }
 
 fn is_positive_definite(m: &DMat3) -> bool {
@@ -159,31 +176,6 @@ fn is_positive_definite(m: &DMat3) -> bool {
     let m1 = m.x_axis.x;
     let m2 = m.x_axis.x * m.y_axis.y - m.y_axis.x * m.x_axis.y;
     m1 > 0.0 && m2 > 0.0 && m.determinant() > 0.0
-}
-
-fn square(i: [f64; 2]) -> (f64, f64) {
-    let (a, b) = (i[0] * i[0], i[1] * i[1]);
-    if i[0] <= 0.0 && i[1] >= 0.0 {
-        (0.0, a.max(b))
-    } else {
-        (a.min(b), a.max(b))
-    }
-}
-
-fn product(i: [f64; 2], j: [f64; 2]) -> (f64, f64) {
-    let p = [i[0] * j[0], i[0] * j[1], i[1] * j[0], i[1] * j[1]];
-    (
-        p.iter().cloned().fold(f64::INFINITY, f64::min),
-        p.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
-    )
-}
-
-fn scale((l, h): (f64, f64), s: f64) -> (f64, f64) {
-    if s >= 0.0 {
-        (l * s, h * s)
-    } else {
-        (h * s, l * s)
-    }
 }
 
 #[cfg(test)]

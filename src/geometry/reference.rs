@@ -9,7 +9,7 @@
 
 use glam::DVec3;
 
-use super::{poly, FunctionalObject};
+use super::{poly, Aabb, FunctionalObject};
 
 /// A ray hit in the object's frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,16 +22,24 @@ pub struct Hit {
 
 /// The first hit of o + t d with the object's surface for t in [t_min, t_max].
 pub fn intersect(obj: &FunctionalObject, o: DVec3, d: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
-    let bounds = obj.bounds().ok()?;
+    intersect_within(obj, &obj.bounds().ok()?, o, d, t_min, t_max)
+}
+
+/// [`intersect`] with the object's bounds ([`FunctionalObject::bounds`]) given,
+/// for callers that trace many rays.
+pub fn intersect_within(obj: &FunctionalObject, bounds: &Aabb, o: DVec3, d: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
     let (b0, b1) = bounds.ray_range(o, d);
     let (t0, t1) = (t_min.max(b0), t_max.min(b1));
     if !(t0 <= t1) {
         return None;
     }
-    let mut cuts: Vec<f64> = obj
-        .perturbations
+    // Only perturbations that are positive somewhere on the segment matter.
+    let relevant: Vec<usize> = (0..obj.perturbations.len())
+        .filter(|&i| positive_somewhere(obj.perturbations[i].quadric.along_ray(o, d), t0, t1))
+        .collect();
+    let mut cuts: Vec<f64> = relevant
         .iter()
-        .flat_map(|p| poly::quadratic_roots(p.quadric.along_ray(o, d)))
+        .flat_map(|&i| poly::quadratic_roots(obj.perturbations[i].quadric.along_ray(o, d)))
         .filter(|&t| t > t0 && t < t1)
         .collect();
     cuts.push(t1);
@@ -41,7 +49,7 @@ pub fn intersect(obj: &FunctionalObject, o: DVec3, d: DVec3, t_min: f64, t_max: 
         if b <= a {
             continue;
         }
-        if let Some(t) = first_root_on_piece(obj, o, d, a, b) {
+        if let Some(t) = first_root_on_piece(obj, &relevant, o, d, a, b) {
             let p = o + t * d;
             return Some(Hit { t, normal: obj.normal(p) });
         }
@@ -50,14 +58,27 @@ pub fn intersect(obj: &FunctionalObject, o: DVec3, d: DVec3, t_min: f64, t_max: 
     None
 }
 
+/// True when the quadratic q is positive somewhere in [t0, t1].
+fn positive_somewhere(q: [f64; 3], t0: f64, t1: f64) -> bool {
+    let at = |t: f64| q[0] + t * (q[1] + t * q[2]);
+    if at(t0) > 0.0 || at(t1) > 0.0 {
+        return true;
+    }
+    if q[2] < 0.0 {
+        let v = -q[1] / (2.0 * q[2]);
+        return v > t0 && v < t1 && at(v) > 0.0;
+    }
+    false
+}
+
 /// The first root of F' on [a, b], a piece on which no Q_i changes sign.
-fn first_root_on_piece(obj: &FunctionalObject, o: DVec3, d: DVec3, a: f64, b: f64) -> Option<f64> {
+fn first_root_on_piece(obj: &FunctionalObject, relevant: &[usize], o: DVec3, d: DVec3, a: f64, b: f64) -> Option<f64> {
     // Expand around the piece's middle for conditioning: s = t - m.
     let m = 0.5 * (a + b);
     let pm = o + m * d;
     let mut c = [0.0; poly::MAX_DEGREE + 1];
     c[..3].copy_from_slice(&obj.base.along_ray(pm, d));
-    for p in &obj.perturbations {
+    for p in relevant.iter().map(|&i| &obj.perturbations[i]) {
         if p.quadric.eval(pm) > 0.0 {
             let q3 = poly::cube(p.quadric.along_ray(pm, d));
             for (ci, qi) in c.iter_mut().zip(q3) {

@@ -1,0 +1,1564 @@
+//! Reading a [`Scene`] from TOML. The format is documented field by field in
+//! `scenes/README.md`.
+//!
+//! Parsing has two stages, and every error names the file, line, column and
+//! field (`scenes/foo.toml:12:10: objects[1].sphere.radius: must be positive
+//! (got -1)`), followed by the offending source line:
+//!
+//! 1. Serde deserializes the text into the private `Raw*` structs. Their leaf
+//!    types (`Finite`, `Positive`, `Triple`, `Coefficients`, …) check their own
+//!    values inside the TOML deserializer, so a bad value is reported at the
+//!    span of its own token; `serde_path_to_error` records the field path on
+//!    the way, and `deny_unknown_fields` rejects misspelt keys.
+//! 2. Checks that involve more than one value (exactly one shape key per
+//!    object, material names, the camera's geometry, bounded surfaces) run on
+//!    the raw tree, which keeps `toml::Spanned` wrappers around the tables and
+//!    values those checks report on.
+//!
+//! Array indices in field paths count from 0, as in `objects[0]`.
+
+use std::fmt::{self, Write as _};
+use std::marker::PhantomData;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3};
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::{Camera, ImageSettings, Light, Material, Scene, SceneObject};
+use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
+
+/// The file name used in messages about [`DEFAULT_SCENE`].
+pub const DEFAULT_SCENE_NAME: &str = "<embedded default scene>";
+
+/// The default showcase scene (`scenes/default.toml`), built into the binary.
+pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.toml");
+
+/// Largest accepted image width or height.
+pub const MAX_IMAGE_SIZE: i64 = 16384;
+/// Largest accepted samples per pixel.
+pub const MAX_SPP: i64 = 1 << 20;
+/// Largest accepted `count` of a `[[objects.scatter]]` generator.
+pub const MAX_SCATTER_COUNT: i64 = 1_000_000;
+/// Name of the built-in material given to objects without a `material` key.
+pub const DEFAULT_MATERIAL_NAME: &str = "<default>";
+
+/// Why a scene could not be loaded. `Display` gives the whole message.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene file could not be read.
+    #[error("{}: cannot read the scene file: {source}", .path.display())]
+    Read {
+        /// The path that was asked for.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The text is not valid TOML, or not a valid scene.
+    #[error("{}", render_invalid(.file, *.line, *.column, .field, .message, .snippet))]
+    Invalid {
+        /// File name as given to [`parse_scene`].
+        file: String,
+        /// Line of the offending text, from 1.
+        line: usize,
+        /// Column of the offending text in characters, from 1.
+        column: usize,
+        /// Field path such as `objects[1].sphere.radius` (indices from 0);
+        /// empty for TOML syntax errors.
+        field: String,
+        /// What is wrong.
+        message: String,
+        /// The offending source line with a caret line under it (may be empty).
+        snippet: String,
+    },
+}
+
+fn render_invalid(
+    file: &str,
+    line: usize,
+    column: usize,
+    field: &str,
+    message: &str,
+    snippet: &str,
+) -> String {
+    let mut s = format!("{file}:{line}:{column}: ");
+    if !field.is_empty() {
+        s.push_str(field);
+        s.push_str(": ");
+    }
+    s.push_str(message);
+    s.push_str(snippet);
+    s
+}
+
+/// Reads and parses the scene file at `path`; messages name the path as given.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_scene(&text, &path.display().to_string())
+}
+
+/// Parses a scene from TOML text; `file_name` is used in error messages.
+pub fn parse_scene(source: &str, file_name: &str) -> Result<Scene, SceneError> {
+    let src = Source {
+        text: source,
+        file: file_name,
+    };
+    let raw: RawScene = serde_path_to_error::deserialize(toml::Deserializer::new(source))
+        .map_err(|e| src.toml_error(e))?;
+    build_scene(&src, raw)
+}
+
+// ---------------------------------------------------------------------------
+// Error locations
+// ---------------------------------------------------------------------------
+
+struct Source<'a> {
+    text: &'a str,
+    file: &'a str,
+}
+
+impl Source<'_> {
+    /// An error at `span` (byte range into the text; start of file if none).
+    fn error(
+        &self,
+        span: Option<Range<usize>>,
+        field: impl Into<String>,
+        message: impl Into<String>,
+    ) -> SceneError {
+        let text = self.text;
+        let span = span.unwrap_or(0..0);
+        let mut start = span.start.min(text.len());
+        while !text.is_char_boundary(start) {
+            start -= 1;
+        }
+        let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+        let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
+        let line = text[..start].matches('\n').count() + 1;
+        let column = text[line_start..start].chars().count() + 1;
+        let mut end = span.end.clamp(start, line_end);
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let source_line = text[line_start..line_end].trim_end_matches('\r');
+        let snippet = if source_line.trim().is_empty() {
+            String::new()
+        } else {
+            // Keep tabs in the padding so that the caret lines up.
+            let pad: String = text[line_start..start]
+                .chars()
+                .map(|c| if c == '\t' { '\t' } else { ' ' })
+                .collect();
+            let width = text[start..end]
+                .trim_end_matches('\r')
+                .chars()
+                .count()
+                .max(1);
+            let gutter = line.to_string().len();
+            format!(
+                "\n{line:>gutter$} | {source_line}\n{:>gutter$} | {pad}{}",
+                "",
+                "^".repeat(width)
+            )
+        };
+        SceneError::Invalid {
+            file: self.file.to_owned(),
+            line,
+            column,
+            field: field.into(),
+            message: message.into(),
+            snippet,
+        }
+    }
+
+    fn toml_error(&self, e: serde_path_to_error::Error<toml::de::Error>) -> SceneError {
+        let mut field = String::new();
+        for segment in e.path() {
+            match segment {
+                serde_path_to_error::Segment::Seq { index } => {
+                    let _ = write!(field, "[{index}]");
+                }
+                serde_path_to_error::Segment::Map { key }
+                | serde_path_to_error::Segment::Enum { variant: key } => {
+                    // Skip the private keys of `toml::Spanned`.
+                    if !key.starts_with("$__") {
+                        if !field.is_empty() {
+                            field.push('.');
+                        }
+                        field.push_str(key);
+                    }
+                }
+                serde_path_to_error::Segment::Unknown => {}
+            }
+        }
+        let inner = e.inner();
+        let mut message = inner
+            .message()
+            .trim()
+            .lines()
+            .map(str::trim)
+            .collect::<Vec<_>>()
+            .join(": ");
+        if let Some(missing) = message
+            .strip_prefix("missing field `")
+            .and_then(|m| m.strip_suffix('`'))
+        {
+            if !field.is_empty() {
+                field.push('.');
+            }
+            field.push_str(missing);
+            message = format!("the required key `{missing}` is missing");
+        } else if field.is_empty() {
+            message = format!("invalid TOML: {message}");
+        } else if message == "invalid type: map, expected a sequence" {
+            // The table header of the array: the path without its indices.
+            let header: String = field
+                .split('[')
+                .map(|p| p.split_once(']').map_or(p, |(_, rest)| rest))
+                .collect();
+            message.push_str(&format!(
+                " (write [[{header}]] with double brackets for each entry)"
+            ));
+        } else if message.starts_with("unknown field `background`") && field.contains('.') {
+            message.push_str(
+                " (top-level keys such as `background` must come before the first [table] header, \
+                 or TOML puts them in that table)",
+            );
+        }
+        self.error(inner.span(), field, message)
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Self-checking leaf types
+// ---------------------------------------------------------------------------
+
+/// A number type that checks its value while being deserialized, so that a
+/// bad value is reported at its own token.
+trait Number: Copy {
+    /// Accepts `v` (already known to be finite) or says why not.
+    fn check(v: f64) -> Result<(), String>;
+    fn new(v: f64) -> Self;
+    fn get(self) -> f64;
+
+    fn parse(v: f64) -> Result<Self, String> {
+        if !v.is_finite() {
+            return Err(format!("must be a finite number (got {v})"));
+        }
+        Self::check(v).map(|()| Self::new(v))
+    }
+}
+
+struct NumberVisitor<T>(PhantomData<T>);
+
+impl<'de, T: Number> Visitor<'de> for NumberVisitor<T> {
+    type Value = T;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number")
+    }
+
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<T, E> {
+        T::parse(v).map_err(E::custom)
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<T, E> {
+        self.visit_f64(v as f64)
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<T, E> {
+        self.visit_f64(v as f64)
+    }
+}
+
+/// Largest accepted colour component (they become f32 on the GPU).
+const MAX_COLOUR: f64 = 1e30;
+
+macro_rules! number_type {
+    ($(#[$meta:meta])* $name:ident, |$v:ident| $check:expr) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug)]
+        struct $name(f64);
+
+        impl Number for $name {
+            fn check($v: f64) -> Result<(), String> {
+                $check
+            }
+            fn new(v: f64) -> Self {
+                Self(v)
+            }
+            fn get(self) -> f64 {
+                self.0
+            }
+        }
+
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                d.deserialize_any(NumberVisitor::<$name>(PhantomData))
+            }
+        }
+    };
+}
+
+fn require(ok: bool, message: impl FnOnce() -> String) -> Result<(), String> {
+    if ok {
+        Ok(())
+    } else {
+        Err(message())
+    }
+}
+
+number_type!(
+    /// Any finite number.
+    Finite,
+    |_v| Ok(())
+);
+number_type!(
+    /// A finite number > 0.
+    Positive,
+    |v| require(v > 0.0, || format!("must be positive (got {v})"))
+);
+number_type!(
+    /// A finite number != 0.
+    NonZero,
+    |v| require(v != 0.0, || "must not be zero".to_owned())
+);
+number_type!(
+    /// A colour component: >= 0 and small enough for f32.
+    NonNegative,
+    |v| {
+        require(v >= 0.0, || format!("must not be negative (got {v})"))?;
+        require(v <= MAX_COLOUR, || format!("must be at most {MAX_COLOUR:e} (got {v})"))
+    }
+);
+number_type!(
+    /// A number in [0, 1].
+    UnitInterval,
+    |v| require((0.0..=1.0).contains(&v), || format!("must be between 0 and 1 (got {v})"))
+);
+number_type!(
+    /// A vertical field of view in degrees, in (0, 180).
+    Fov,
+    |v| require(v > 0.0 && v < 180.0, || format!("must be between 0 and 180 degrees, exclusive (got {v})"))
+);
+number_type!(
+    /// A cone's half-angle in degrees, in (0, 90).
+    HalfAngle,
+    |v| require(v > 0.0 && v < 90.0, || format!("must be between 0 and 90 degrees, exclusive (got {v})"))
+);
+number_type!(
+    /// Exposure in stops.
+    Exposure,
+    |v| require(v.abs() <= 100.0, || format!("must be between -100 and 100 stops (got {v})"))
+);
+
+/// An integer in `LO..=HI`.
+#[derive(Clone, Copy, Debug)]
+struct Int<const LO: i64, const HI: i64>(i64);
+
+type Dimension = Int<1, MAX_IMAGE_SIZE>;
+type Samples = Int<1, MAX_SPP>;
+type Seed = Int<0, { u32::MAX as i64 }>;
+type Count = Int<1, MAX_SCATTER_COUNT>;
+type Sheets = Int<1, 2>;
+
+struct IntVisitor<const LO: i64, const HI: i64>;
+
+impl<'de, const LO: i64, const HI: i64> Visitor<'de> for IntVisitor<LO, HI> {
+    type Value = Int<LO, HI>;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "an integer from {LO} to {HI}")
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Self::Value, E> {
+        if (LO..=HI).contains(&v) {
+            Ok(Int(v))
+        } else {
+            Err(E::custom(format!(
+                "must be an integer from {LO} to {HI} (got {v})"
+            )))
+        }
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Self::Value, E> {
+        self.visit_i64(i64::try_from(v).unwrap_or(i64::MAX))
+    }
+}
+
+impl<'de, const LO: i64, const HI: i64> Deserialize<'de> for Int<LO, HI> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(IntVisitor::<LO, HI>)
+    }
+}
+
+impl<const LO: i64, const HI: i64> Int<LO, HI> {
+    fn get(self) -> i64 {
+        self.0
+    }
+}
+
+/// Reads exactly `N` numbers of type `T` from an array.
+fn read_numbers<'de, T, A, const N: usize>(mut seq: A) -> Result<[f64; N], A::Error>
+where
+    T: Number + Deserialize<'de>,
+    A: SeqAccess<'de>,
+{
+    let mut out = [0.0; N];
+    let mut n = 0;
+    while let Some(x) = seq.next_element::<T>()? {
+        if n < N {
+            out[n] = x.get();
+        }
+        n += 1;
+    }
+    if n != N {
+        return Err(de::Error::custom(format!(
+            "must be an array of {N} numbers (got {n})"
+        )));
+    }
+    Ok(out)
+}
+
+/// An array of three numbers, each checked as a `T`.
+#[derive(Clone, Copy, Debug)]
+struct Triple<T>(DVec3, PhantomData<T>);
+
+impl<T> Triple<T> {
+    fn get(self) -> DVec3 {
+        self.0
+    }
+}
+
+struct TripleVisitor<T>(PhantomData<T>);
+
+impl<'de, T: Number + Deserialize<'de>> Visitor<'de> for TripleVisitor<T> {
+    type Value = Triple<T>;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("an array of 3 numbers")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+        read_numbers::<T, A, 3>(seq).map(|v| Triple(DVec3::from_array(v), PhantomData))
+    }
+}
+
+impl<'de, T: Number + Deserialize<'de>> Deserialize<'de> for Triple<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TripleVisitor::<T>(PhantomData))
+    }
+}
+
+/// A positive number (the same on every axis) or an array of three.
+#[derive(Clone, Copy, Debug)]
+struct PositiveVec(DVec3);
+
+struct PositiveVecVisitor;
+
+impl<'de> Visitor<'de> for PositiveVecVisitor {
+    type Value = PositiveVec;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a positive number or an array of 3 positive numbers")
+    }
+
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<PositiveVec, E> {
+        Positive::parse(v)
+            .map(|p| PositiveVec(DVec3::splat(p.get())))
+            .map_err(E::custom)
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<PositiveVec, E> {
+        self.visit_f64(v as f64)
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<PositiveVec, E> {
+        self.visit_f64(v as f64)
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<PositiveVec, A::Error> {
+        read_numbers::<Positive, A, 3>(seq).map(|v| PositiveVec(DVec3::from_array(v)))
+    }
+}
+
+impl<'de> Deserialize<'de> for PositiveVec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(PositiveVecVisitor)
+    }
+}
+
+/// The ten coefficients of a non-degenerate quadric, in the order of
+/// [`Quadric::from_coefficients`].
+#[derive(Clone, Copy, Debug)]
+struct Coefficients(Quadric);
+
+struct CoefficientsVisitor;
+
+impl<'de> Visitor<'de> for CoefficientsVisitor {
+    type Value = Coefficients;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("an array of 10 numbers [xx, yy, zz, xy, yz, xz, x, y, z, k]")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Coefficients, A::Error> {
+        let k = read_numbers::<Finite, A, 10>(seq)?;
+        let q = Quadric::from_coefficients(k);
+        if q.is_degenerate() {
+            return Err(de::Error::custom(
+                "the quadric is degenerate: its quadratic and linear coefficients (the first 9) are all zero, \
+                 so it has no surface",
+            ));
+        }
+        Ok(Coefficients(q))
+    }
+}
+
+impl<'de> Deserialize<'de> for Coefficients {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(CoefficientsVisitor)
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The raw tree
+// ---------------------------------------------------------------------------
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a scene table")]
+struct RawScene {
+    background: Option<Triple<NonNegative>>,
+    image: Option<RawImage>,
+    camera: Spanned<RawCamera>,
+    #[serde(default)]
+    materials: Vec<Spanned<RawMaterial>>,
+    #[serde(default)]
+    objects: Vec<Spanned<RawObject>>,
+    #[serde(default)]
+    lights: Vec<Spanned<RawLight>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an [image] table")]
+struct RawImage {
+    width: Option<Dimension>,
+    height: Option<Dimension>,
+    spp: Option<Samples>,
+    seed: Option<Seed>,
+    exposure: Option<Exposure>,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a [camera] table with position and look_at"
+)]
+struct RawCamera {
+    position: Triple<Finite>,
+    look_at: Spanned<Triple<Finite>>,
+    up: Option<Spanned<Triple<Finite>>>,
+    fov: Option<Fov>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a material table with a name")]
+struct RawMaterial {
+    name: Spanned<String>,
+    albedo: Option<Triple<UnitInterval>>,
+    emission: Option<Triple<NonNegative>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an object table")]
+struct RawObject {
+    name: Option<String>,
+    material: Option<Spanned<String>>,
+    sphere: Option<Spanned<RawSphere>>,
+    ellipsoid: Option<Spanned<RawEllipsoid>>,
+    plane: Option<Spanned<RawPlane>>,
+    cylinder: Option<Spanned<RawCylinder>>,
+    cone: Option<Spanned<RawCone>>,
+    paraboloid: Option<Spanned<RawParaboloid>>,
+    hyperboloid: Option<Spanned<RawHyperboloid>>,
+    quadric: Option<Spanned<Coefficients>>,
+    clip: Option<Spanned<RawClip>>,
+    translate: Option<Triple<Finite>>,
+    rotate: Option<Triple<Finite>>,
+    scale: Option<PositiveVec>,
+    #[serde(default)]
+    perturbations: Vec<Spanned<RawPerturbation>>,
+    #[serde(default)]
+    scatter: Vec<Spanned<RawScatter>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table such as { radius = 1 }")]
+struct RawSphere {
+    radius: Positive,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table such as { radii = [1, 0.5, 2] }"
+)]
+struct RawEllipsoid {
+    radii: Triple<Positive>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an empty table {}")]
+struct RawPlane {}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table such as { radius = 0.5 }")]
+struct RawCylinder {
+    radius: Positive,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table such as { half_angle = 30 }")]
+struct RawCone {
+    half_angle: HalfAngle,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table such as { curvature = 1 }")]
+struct RawParaboloid {
+    curvature: NonZero,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table such as { radius = 0.5, slope = 1, sheets = 1 }"
+)]
+struct RawHyperboloid {
+    radius: Positive,
+    slope: Positive,
+    sheets: Option<Sheets>,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table such as { min = [-1, -1, -1], max = [1, 1, 1] }"
+)]
+struct RawClip {
+    min: Triple<Finite>,
+    max: Triple<Finite>,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a perturbation table with `f` and one of `bump` or `quadric`"
+)]
+struct RawPerturbation {
+    bump: Option<RawBump>,
+    quadric: Option<Spanned<Coefficients>>,
+    f: Finite,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table such as { centre = [0, 1, 0], radius = 0.2 }"
+)]
+struct RawBump {
+    #[serde(alias = "center")]
+    centre: Triple<Finite>,
+    radius: PositiveVec,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a scatter table with count, radius and f"
+)]
+struct RawScatter {
+    count: Count,
+    on_radii: Option<Triple<Positive>>,
+    #[serde(alias = "center")]
+    centre: Option<Triple<Finite>>,
+    radius: PositiveVec,
+    f: Finite,
+    alternate: Option<bool>,
+    seed: Option<Seed>,
+    jitter: Option<UnitInterval>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq)]
+#[serde(rename_all = "lowercase")]
+enum LightKind {
+    Point,
+    Sphere,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a light table with type and position"
+)]
+struct RawLight {
+    #[serde(rename = "type")]
+    kind: LightKind,
+    position: Triple<Finite>,
+    intensity: Option<Spanned<Triple<NonNegative>>>,
+    radius: Option<Spanned<Positive>>,
+    radiance: Option<Spanned<Triple<NonNegative>>>,
+}
+
+// ---------------------------------------------------------------------------
+// Building the scene
+// ---------------------------------------------------------------------------
+
+fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
+    let image = raw.image.as_ref();
+    let image = ImageSettings {
+        width: image.and_then(|i| i.width).map_or(640, |v| v.get() as u32),
+        height: image.and_then(|i| i.height).map_or(480, |v| v.get() as u32),
+        spp: image.and_then(|i| i.spp).map_or(16, |v| v.get() as u32),
+        seed: image.and_then(|i| i.seed).map_or(0, |v| v.get() as u32),
+        exposure: image
+            .and_then(|i| i.exposure)
+            .map_or(0.0, |v| v.get() as f32),
+    };
+    let camera = build_camera(src, &raw.camera)?;
+    let background = raw.background.map_or(Vec3::ZERO, |b| b.get().as_vec3());
+
+    let mut materials: Vec<Material> = Vec::with_capacity(raw.materials.len() + 1);
+    let mut material_lines = Vec::with_capacity(raw.materials.len());
+    for (i, m) in raw.materials.iter().enumerate() {
+        let span = m.span();
+        let m = m.get_ref();
+        let name = m.name.get_ref();
+        if name.is_empty() {
+            return Err(src.error(
+                Some(m.name.span()),
+                format!("materials[{i}].name"),
+                "must not be empty",
+            ));
+        }
+        if let Some(first) = materials.iter().position(|o| &o.name == name) {
+            let line: usize = material_lines[first];
+            return Err(src.error(
+                Some(m.name.span()),
+                format!("materials[{i}].name"),
+                format!("duplicate material name {name:?} (first defined at line {line} as materials[{first}])"),
+            ));
+        }
+        material_lines.push(
+            src.text[..span.start.min(src.text.len())]
+                .matches('\n')
+                .count()
+                + 1,
+        );
+        materials.push(Material {
+            name: name.clone(),
+            albedo: m.albedo.map_or(Vec3::splat(0.8), |a| a.get().as_vec3()),
+            emission: m.emission.map_or(Vec3::ZERO, |e| e.get().as_vec3()),
+        });
+    }
+    let user_materials = materials.len();
+
+    let mut objects = Vec::with_capacity(raw.objects.len());
+    for (i, o) in raw.objects.iter().enumerate() {
+        let material = match &o.get_ref().material {
+            Some(name) => match materials[..user_materials]
+                .iter()
+                .position(|m| &m.name == name.get_ref())
+            {
+                Some(k) => k,
+                None => {
+                    let known: Vec<String> = materials[..user_materials]
+                        .iter()
+                        .map(|m| format!("{:?}", m.name))
+                        .collect();
+                    let known = if known.is_empty() {
+                        "no [[materials]] are defined".to_owned()
+                    } else {
+                        format!("defined: {}", known.join(", "))
+                    };
+                    return Err(src.error(
+                        Some(name.span()),
+                        format!("objects[{i}].material"),
+                        format!("unknown material {:?} ({known})", name.get_ref()),
+                    ));
+                }
+            },
+            None => {
+                if materials.len() == user_materials {
+                    materials.push(Material {
+                        name: DEFAULT_MATERIAL_NAME.to_owned(),
+                        albedo: Vec3::splat(0.8),
+                        emission: Vec3::ZERO,
+                    });
+                }
+                user_materials
+            }
+        };
+        objects.push(build_object(src, i, o, material)?);
+    }
+
+    let lights = raw
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| build_light(src, i, l))
+        .collect::<Result<Vec<_>, _>>()?;
+
+    Ok(Scene {
+        image,
+        camera,
+        background,
+        materials,
+        objects,
+        lights,
+    })
+}
+
+fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {
+    let c = raw.get_ref();
+    let position = c.position.get();
+    let look_at = c.look_at.get_ref().get();
+    let up = c.up.as_ref().map_or(DVec3::Y, |u| u.get_ref().get());
+    let view = look_at - position;
+    let scale = position.abs().max(look_at.abs()).max_element().max(1.0);
+    if view.length() <= 1e-9 * scale {
+        return Err(src.error(
+            Some(c.look_at.span()),
+            "camera.look_at",
+            "must differ from camera.position (the view direction is look_at - position)",
+        ));
+    }
+    let (up_span, default_note) = match &c.up {
+        Some(u) => (u.span(), ""),
+        None => (raw.span(), " (the default up is [0, 1, 0]; set camera.up)"),
+    };
+    if up.length() == 0.0 {
+        return Err(src.error(Some(up_span), "camera.up", "must not be zero"));
+    }
+    let sin = view.normalize().cross(up.normalize()).length();
+    if sin < 1e-6 {
+        return Err(src.error(
+            Some(up_span),
+            "camera.up",
+            format!("must not be parallel to the view direction look_at - position{default_note}"),
+        ));
+    }
+    Ok(Camera {
+        position,
+        look_at,
+        up,
+        vfov_degrees: c.fov.map_or(40.0, |f| f.get()),
+    })
+}
+
+/// The shape keys of an object, in the order they are listed in messages.
+const SHAPE_KEYS: [&str; 8] = [
+    "sphere",
+    "ellipsoid",
+    "plane",
+    "cylinder",
+    "cone",
+    "paraboloid",
+    "hyperboloid",
+    "quadric",
+];
+
+/// The base quadric of an object's one shape key, with that key and the span
+/// of its value.
+fn base_shape(
+    src: &Source,
+    i: usize,
+    raw: &Spanned<RawObject>,
+) -> Result<(Quadric, &'static str, Range<usize>), SceneError> {
+    let o = raw.get_ref();
+    let present: Vec<(&'static str, Range<usize>)> = [
+        o.sphere.as_ref().map(Spanned::span),
+        o.ellipsoid.as_ref().map(Spanned::span),
+        o.plane.as_ref().map(Spanned::span),
+        o.cylinder.as_ref().map(Spanned::span),
+        o.cone.as_ref().map(Spanned::span),
+        o.paraboloid.as_ref().map(Spanned::span),
+        o.hyperboloid.as_ref().map(Spanned::span),
+        o.quadric.as_ref().map(Spanned::span),
+    ]
+    .into_iter()
+    .zip(SHAPE_KEYS)
+    .filter_map(|(s, k)| s.map(|s| (k, s)))
+    .collect();
+    let (key, span) = match present.as_slice() {
+        [one] => one.clone(),
+        [] => {
+            return Err(src.error(
+                Some(raw.span()),
+                format!("objects[{i}]"),
+                format!(
+                    "the object needs exactly one shape key ({}); found none",
+                    SHAPE_KEYS.join(", ")
+                ),
+            ))
+        }
+        [_, second, ..] => {
+            let keys: Vec<&str> = present.iter().map(|(k, _)| *k).collect();
+            return Err(src.error(
+                Some(second.1.clone()),
+                format!("objects[{i}].{}", second.0),
+                format!(
+                    "the object needs exactly one shape key; found {}: {}",
+                    keys.len(),
+                    keys.join(", ")
+                ),
+            ));
+        }
+    };
+    let q = |k: [f64; 10]| Quadric::from_coefficients(k);
+    let base = if let Some(s) = &o.sphere {
+        Quadric::ellipsoid(DVec3::ZERO, DVec3::splat(s.get_ref().radius.get()))
+    } else if let Some(e) = &o.ellipsoid {
+        Quadric::ellipsoid(DVec3::ZERO, e.get_ref().radii.get())
+    } else if o.plane.is_some() {
+        q([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0])
+    } else if let Some(c) = &o.cylinder {
+        let w = 1.0 / c.get_ref().radius.get().powi(2);
+        q([-w, 0.0, -w, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+    } else if let Some(c) = &o.cone {
+        let t = c.get_ref().half_angle.get().to_radians().tan().powi(2);
+        q([-1.0, t, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    } else if let Some(p) = &o.paraboloid {
+        let k = p.get_ref().curvature.get();
+        q([-k, 0.0, -k, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+    } else if let Some(h) = &o.hyperboloid {
+        let h = h.get_ref();
+        let w = 1.0 / h.radius.get().powi(2);
+        let s = h.slope.get().powi(2) * w;
+        let k = if h.sheets.map_or(1, Int::get) == 1 {
+            1.0
+        } else {
+            -1.0
+        };
+        q([-w, s, -w, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, k])
+    } else if let Some(c) = &o.quadric {
+        c.get_ref().0
+    } else {
+        unreachable!("exactly one shape key is present")
+    };
+    Ok((base, key, span))
+}
+
+fn build_object(
+    src: &Source,
+    i: usize,
+    raw: &Spanned<RawObject>,
+    material: usize,
+) -> Result<SceneObject, SceneError> {
+    let o = raw.get_ref();
+    let (base, shape_key, shape_span) = base_shape(src, i, raw)?;
+
+    let clip = match &o.clip {
+        Some(c) => {
+            let (min, max) = (c.get_ref().min.get(), c.get_ref().max.get());
+            if let Some(axis) = (0..3).find(|&k| min[k] >= max[k]) {
+                let name = ["x", "y", "z"][axis];
+                return Err(src.error(
+                    Some(c.span()),
+                    format!("objects[{i}].clip"),
+                    format!(
+                        "clip.min must be less than clip.max on every axis ({name}: min {} >= max {})",
+                        min[axis], max[axis]
+                    ),
+                ));
+            }
+            Some(Aabb::new(min, max))
+        }
+        None => None,
+    };
+
+    let mut perturbations = Vec::new();
+    for (j, p) in o.perturbations.iter().enumerate() {
+        let r = p.get_ref();
+        let quadric = match (&r.bump, &r.quadric) {
+            (Some(b), None) => Quadric::ellipsoid(b.centre.get(), b.radius.0),
+            (None, Some(q)) => q.get_ref().0,
+            (b, q) => {
+                let found = if b.is_some() && q.is_some() {
+                    "found both"
+                } else {
+                    "found neither"
+                };
+                return Err(src.error(
+                    Some(p.span()),
+                    format!("objects[{i}].perturbations[{j}]"),
+                    format!("a perturbation needs exactly one of `bump` and `quadric`; {found}"),
+                ));
+            }
+        };
+        perturbations.push(Perturbation {
+            quadric,
+            form_factor: r.f.get(),
+        });
+    }
+    for (j, s) in o.scatter.iter().enumerate() {
+        let r = s.get_ref();
+        let on_radii = match (&r.on_radii, &o.sphere, &o.ellipsoid) {
+            (Some(v), _, _) => v.get(),
+            (None, Some(sphere), _) => DVec3::splat(sphere.get_ref().radius.get()),
+            (None, None, Some(e)) => e.get_ref().radii.get(),
+            (None, None, None) => {
+                return Err(src.error(
+                    Some(s.span()),
+                    format!("objects[{i}].scatter[{j}].on_radii"),
+                    "the required key `on_radii` is missing (it defaults to the radii only for spheres and ellipsoids)",
+                ));
+            }
+        };
+        perturbations.extend(scatter(ScatterParams {
+            count: r.count.get() as usize,
+            centre: r.centre.map_or(DVec3::ZERO, Triple::get),
+            on_radii,
+            radius: r.radius.0,
+            form_factor: r.f.get(),
+            alternate: r.alternate.unwrap_or(false),
+            seed: r.seed.map_or(0, |v| v.get() as u32),
+            jitter: r.jitter.map_or(0.0, |v| v.get()),
+        }));
+    }
+
+    let shape = FunctionalObject {
+        base,
+        perturbations,
+        clip,
+    };
+    if let Err(e) = shape.bounds() {
+        return Err(geometry_error(
+            src, i, raw, shape_key, shape_span, &shape, e,
+        ));
+    }
+
+    let translate = o.translate.map_or(DVec3::ZERO, Triple::get);
+    let rotate = o.rotate.map_or(DVec3::ZERO, Triple::get);
+    let scale = o.scale.map_or(DVec3::ONE, |s| s.0);
+    let rotation = DQuat::from_euler(
+        EulerRot::XYZ,
+        rotate.x.to_radians(),
+        rotate.y.to_radians(),
+        rotate.z.to_radians(),
+    );
+    let transform = DAffine3::from_scale_rotation_translation(scale, rotation, translate);
+
+    Ok(SceneObject {
+        name: o.name.clone().unwrap_or_else(|| format!("objects[{i}]")),
+        shape,
+        transform,
+        material,
+    })
+}
+
+fn geometry_error(
+    src: &Source,
+    i: usize,
+    raw: &Spanned<RawObject>,
+    shape_key: &str,
+    shape_span: Range<usize>,
+    shape: &FunctionalObject,
+    e: GeometryError,
+) -> SceneError {
+    let o = raw.get_ref();
+    match e {
+        GeometryError::Unbounded(_) if shape.base.support_bounds().is_none() => src.error(
+            Some(shape_span),
+            format!("objects[{i}].{shape_key}"),
+            format!(
+                "the {shape_key} surface is unbounded; give the object a clip box, \
+                 e.g. clip = {{ min = [-1, -1, -1], max = [1, 1, 1] }}"
+            ),
+        ),
+        GeometryError::Unbounded(_) => {
+            let j = o
+                .perturbations
+                .iter()
+                .position(|p| {
+                    let r = p.get_ref();
+                    r.f.get() > 0.0
+                        && r.quadric
+                            .as_ref()
+                            .is_some_and(|q| q.get_ref().0.support_bounds().is_none())
+                })
+                .unwrap_or(0);
+            let span = o.perturbations.get(j).map_or(raw.span(), Spanned::span);
+            src.error(
+                Some(span),
+                format!("objects[{i}].perturbations[{j}]"),
+                "a perturbation with a positive form factor and an unbounded support (its quadric is >= 0 \
+                 arbitrarily far away) makes the surface unbounded; give the object a clip box",
+            )
+        }
+        GeometryError::Empty(_) => match &o.clip {
+            Some(c) => src.error(
+                Some(c.span()),
+                format!("objects[{i}].clip"),
+                "the surface has no point inside the clip box",
+            ),
+            None => src.error(
+                Some(shape_span),
+                format!("objects[{i}].{shape_key}"),
+                "the surface is empty: the quadric is negative everywhere",
+            ),
+        },
+        e => src.error(Some(raw.span()), format!("objects[{i}]"), e.to_string()),
+    }
+}
+
+fn build_light(src: &Source, i: usize, raw: &Spanned<RawLight>) -> Result<Light, SceneError> {
+    let l = raw.get_ref();
+    let position = l.position.get();
+    let unexpected = |key: &str, span: Range<usize>, kind: &str| {
+        src.error(
+            Some(span),
+            format!("lights[{i}].{key}"),
+            format!("`{key}` does not apply to a {kind} light"),
+        )
+    };
+    let missing = |key: &str, kind: &str| {
+        src.error(
+            Some(raw.span()),
+            format!("lights[{i}].{key}"),
+            format!("the required key `{key}` of a {kind} light is missing"),
+        )
+    };
+    match l.kind {
+        LightKind::Point => {
+            if let Some(r) = &l.radius {
+                return Err(unexpected("radius", r.span(), "point"));
+            }
+            if let Some(r) = &l.radiance {
+                return Err(unexpected("radiance", r.span(), "point (use `intensity`)"));
+            }
+            let intensity = l
+                .intensity
+                .as_ref()
+                .ok_or_else(|| missing("intensity", "point"))?;
+            Ok(Light::Point {
+                position,
+                intensity: intensity.get_ref().get().as_vec3(),
+            })
+        }
+        LightKind::Sphere => {
+            if let Some(r) = &l.intensity {
+                return Err(unexpected("intensity", r.span(), "sphere (use `radiance`)"));
+            }
+            let radius = l
+                .radius
+                .as_ref()
+                .ok_or_else(|| missing("radius", "sphere"))?;
+            let radiance = l
+                .radiance
+                .as_ref()
+                .ok_or_else(|| missing("radiance", "sphere"))?;
+            Ok(Light::Sphere {
+                centre: position,
+                radius: radius.get_ref().get(),
+                radiance: radiance.get_ref().get().as_vec3(),
+            })
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Scattered bumps
+// ---------------------------------------------------------------------------
+
+struct ScatterParams {
+    count: usize,
+    centre: DVec3,
+    on_radii: DVec3,
+    radius: DVec3,
+    form_factor: f64,
+    alternate: bool,
+    seed: u32,
+    jitter: f64,
+}
+
+/// `count` ellipsoidal bumps centred on points of the ellipsoid `on_radii`
+/// around `centre`, placed by a Fibonacci spiral around the y axis and
+/// optionally jittered along the surface by up to `jitter` times the mean
+/// spacing.
+fn scatter(p: ScatterParams) -> impl Iterator<Item = Perturbation> {
+    let n = p.count;
+    let golden_angle = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let spacing = (4.0 * std::f64::consts::PI / n as f64).sqrt();
+    (0..n).map(move |i| {
+        let y = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+        let r = (1.0 - y * y).max(0.0).sqrt();
+        let phi = i as f64 * golden_angle;
+        let mut u = DVec3::new(r * phi.cos(), y, r * phi.sin());
+        if p.jitter > 0.0 {
+            let t1 = u.any_orthonormal_vector();
+            let t2 = u.cross(t1);
+            let a = hash_unit(p.seed, i as u64, 0) - 0.5;
+            let b = hash_unit(p.seed, i as u64, 1) - 0.5;
+            u = (u + p.jitter * spacing * (a * t1 + b * t2)).normalize();
+        }
+        let f = if p.alternate && i % 2 == 1 {
+            -p.form_factor
+        } else {
+            p.form_factor
+        };
+        Perturbation {
+            quadric: Quadric::ellipsoid(p.centre + p.on_radii * u, p.radius),
+            form_factor: f,
+        }
+    })
+}
+
+/// A deterministic number in [0, 1) from a seed, an index and a stream
+/// (SplitMix64 finalizer).
+fn hash_unit(seed: u32, index: u64, stream: u64) -> f64 {
+    let mut z = (u64::from(seed) << 32 ^ index)
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(stream.wrapping_mul(0xD1B5_4A32_D192_ED03));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CAMERA: &str = "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n";
+
+    fn parse(body: &str) -> Scene {
+        let text = format!("{CAMERA}{body}");
+        parse_scene(&text, "test.toml").unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn one_shape(shape: &str) -> FunctionalObject {
+        parse(&format!(
+            "[[objects]]\n{shape}\nclip = {{ min = [-3, -3, -3], max = [3, 3, 3] }}\n"
+        ))
+        .objects[0]
+            .shape
+            .clone()
+    }
+
+    fn near(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9
+    }
+
+    #[test]
+    fn defaults() {
+        let s = parse("");
+        assert_eq!(
+            s.image,
+            ImageSettings {
+                width: 640,
+                height: 480,
+                spp: 16,
+                seed: 0,
+                exposure: 0.0
+            }
+        );
+        assert_eq!(s.camera.up, DVec3::Y);
+        assert_eq!(s.camera.vfov_degrees, 40.0);
+        assert_eq!(s.background, Vec3::ZERO);
+        assert!(s.objects.is_empty() && s.lights.is_empty() && s.materials.is_empty());
+    }
+
+    #[test]
+    fn image_and_background() {
+        let text = "background = [0.1, 0.2, 0.3]\n[image]\nwidth = 64\nheight = 48\nspp = 3\nseed = 4000000000\nexposure = -1.5\n";
+        let s = parse_scene(&format!("{text}{CAMERA}"), "t.toml").unwrap();
+        assert_eq!(
+            s.image,
+            ImageSettings {
+                width: 64,
+                height: 48,
+                spp: 3,
+                seed: 4_000_000_000,
+                exposure: -1.5
+            }
+        );
+        assert_eq!(s.background, Vec3::new(0.1, 0.2, 0.3));
+    }
+
+    #[test]
+    fn sphere_and_ellipsoid() {
+        let s = one_shape("sphere = { radius = 2 }");
+        assert!(near(s.eval(DVec3::new(2.0, 0.0, 0.0)), 0.0));
+        assert!(near(s.eval(DVec3::new(0.0, 0.0, -2.0)), 0.0));
+        assert!(s.eval(DVec3::ZERO) > 0.0);
+        assert!(s.eval(DVec3::new(0.0, 2.1, 0.0)) < 0.0);
+        let e = one_shape("ellipsoid = { radii = [1, 0.5, 2] }");
+        for p in [
+            DVec3::X,
+            DVec3::new(0.0, 0.5, 0.0),
+            DVec3::new(0.0, 0.0, -2.0),
+        ] {
+            assert!(near(e.eval(p), 0.0));
+        }
+        assert!(e.eval(DVec3::ZERO) > 0.0);
+    }
+
+    #[test]
+    fn plane_cylinder_cone_paraboloid() {
+        let p = one_shape("plane = {}");
+        assert!(near(p.eval(DVec3::new(1.0, 0.0, 2.0)), 0.0));
+        assert!(p.eval(DVec3::new(0.0, -1.0, 0.0)) > 0.0);
+        assert!((p.normal(DVec3::ZERO) - DVec3::Y).length() < 1e-12);
+        let c = one_shape("cylinder = { radius = 0.5 }");
+        assert!(near(c.eval(DVec3::new(0.5, 7.0, 0.0)), 0.0));
+        assert!(near(c.eval(DVec3::new(0.3, -1.0, 0.4)), 0.0));
+        assert!(c.eval(DVec3::new(0.0, 1.0, 0.0)) > 0.0);
+        let k = one_shape("cone = { half_angle = 30 }");
+        let t = 30f64.to_radians().tan();
+        assert!(near(k.eval(DVec3::new(t * 2.0, 2.0, 0.0)), 0.0));
+        assert!(near(k.eval(DVec3::new(0.0, -1.0, t)), 0.0));
+        assert!(k.eval(DVec3::new(0.0, 1.0, 0.0)) > 0.0);
+        assert!(k.eval(DVec3::new(1.0, 0.0, 0.0)) < 0.0);
+        let q = one_shape("paraboloid = { curvature = 2 }");
+        assert!(near(q.eval(DVec3::new(1.0, 2.0, 0.0)), 0.0));
+        assert!(q.eval(DVec3::new(0.0, 1.0, 0.0)) > 0.0);
+        assert!(q.eval(DVec3::new(0.0, -1.0, 0.0)) < 0.0);
+    }
+
+    #[test]
+    fn hyperboloids() {
+        let h = one_shape("hyperboloid = { radius = 0.5, slope = 2 }");
+        assert!(near(h.eval(DVec3::new(0.5, 0.0, 0.0)), 0.0));
+        // x² + z² = r² + s² y²
+        let r = (0.25f64 + 4.0).sqrt();
+        assert!(near(h.eval(DVec3::new(0.0, 1.0, r)), 0.0));
+        assert!(h.eval(DVec3::new(0.0, 1.0, 0.0)) > 0.0);
+        assert!(h.eval(DVec3::new(1.0, 0.0, 0.0)) < 0.0);
+        let h2 = one_shape("hyperboloid = { radius = 0.5, slope = 2, sheets = 2 }");
+        // s² y² - (x² + z²) = r²: vertices at y = ±r/s
+        assert!(near(h2.eval(DVec3::new(0.0, 0.25, 0.0)), 0.0));
+        assert!(near(h2.eval(DVec3::new(0.0, -0.25, 0.0)), 0.0));
+        assert!(near(
+            h2.eval(DVec3::new((4.0f64 - 0.25).sqrt(), 1.0, 0.0)),
+            0.0
+        ));
+        assert!(h2.eval(DVec3::new(0.0, 1.0, 0.0)) > 0.0);
+        assert!(h2.eval(DVec3::ZERO) < 0.0);
+    }
+
+    #[test]
+    fn general_quadric_and_clip() {
+        let s = parse(
+            "[[objects]]\nquadric = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\nclip = { min = [-1, -2, -3], max = [1, 2, 3] }\n",
+        );
+        let o = &s.objects[0].shape;
+        assert_eq!(
+            o.base.coefficients(),
+            [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0]
+        );
+        assert_eq!(
+            o.clip,
+            Some(Aabb::new(
+                DVec3::new(-1.0, -2.0, -3.0),
+                DVec3::new(1.0, 2.0, 3.0)
+            ))
+        );
+        assert_eq!(
+            one_shape("sphere = { radius = 1 }").clip.unwrap().max,
+            DVec3::splat(3.0)
+        );
+        assert_eq!(
+            parse("[[objects]]\nsphere = { radius = 1 }\n").objects[0]
+                .shape
+                .clip,
+            None
+        );
+    }
+
+    #[test]
+    fn transforms() {
+        let s = parse(
+            "[[objects]]\nsphere = { radius = 1 }\ntranslate = [1, 2, 3]\n\
+             [[objects]]\nsphere = { radius = 1 }\nrotate = [0, 0, 90]\nscale = 2\n\
+             [[objects]]\nsphere = { radius = 1 }\nscale = [1, 2, 3]\n\
+             [[objects]]\nsphere = { radius = 1 }\nrotate = [90, 90, 0]\n",
+        );
+        let t = &s.objects;
+        assert_eq!(
+            t[0].transform,
+            DAffine3::from_translation(DVec3::new(1.0, 2.0, 3.0))
+        );
+        let p = t[1].transform.transform_point3(DVec3::X);
+        assert!((p - DVec3::new(0.0, 2.0, 0.0)).length() < 1e-12, "{p}");
+        let p = t[2].transform.transform_point3(DVec3::ONE);
+        assert!((p - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-12);
+        // Euler XYZ: R = Rx · Ry · Rz, so the vector is turned about z, then y, then x.
+        let r = glam::DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2)
+            * glam::DMat3::from_rotation_y(std::f64::consts::FRAC_PI_2);
+        let v = DVec3::new(0.3, -0.5, 0.7);
+        assert!((t[3].transform.transform_vector3(v) - r * v).length() < 1e-12);
+        assert_eq!(t[0].name, "objects[0]");
+    }
+
+    #[test]
+    fn perturbations() {
+        let s = parse(
+            "[[objects]]\nsphere = { radius = 1 }\n\
+             [[objects.perturbations]]\nbump = { centre = [0, 1, 0], radius = 0.2 }\nf = 0.5\n\
+             [[objects.perturbations]]\nbump = { center = [1, 0, 0], radius = [0.1, 0.2, 0.3] }\nf = -0.25\n\
+             [[objects.perturbations]]\nquadric = [-1, -1, -1, 0, 0, 0, 0, 0, 0, 0.01]\nf = 2\n",
+        );
+        let p = &s.objects[0].shape.perturbations;
+        assert_eq!(p.len(), 3);
+        assert_eq!(
+            p[0].quadric,
+            Quadric::ellipsoid(DVec3::Y, DVec3::splat(0.2))
+        );
+        assert_eq!(p[0].form_factor, 0.5);
+        assert_eq!(
+            p[1].quadric,
+            Quadric::ellipsoid(DVec3::X, DVec3::new(0.1, 0.2, 0.3))
+        );
+        assert_eq!(p[1].form_factor, -0.25);
+        assert_eq!(p[2].quadric.coefficients()[9], 0.01);
+        // The bump raises the surface above the pole.
+        assert!(s.objects[0].shape.eval(DVec3::new(0.0, 1.01, 0.0)) > 0.0);
+    }
+
+    #[test]
+    fn scatter_places_bumps_on_the_ellipsoid() {
+        let s = parse(
+            "[[objects]]\nsphere = { radius = 2 }\n\
+             [[objects.perturbations]]\nbump = { centre = [0, 2, 0], radius = 0.2 }\nf = 0.5\n\
+             [[objects.scatter]]\ncount = 1000\nradius = 0.05\nf = 0.8\nalternate = true\n\
+             [[objects.scatter]]\ncount = 10\non_radii = [1, 2, 3]\ncentre = [0, 1, 0]\nradius = 0.1\nf = 0.3\njitter = 0.5\nseed = 7\n",
+        );
+        let p = &s.objects[0].shape.perturbations;
+        assert_eq!(p.len(), 1 + 1000 + 10);
+        let centre = |q: &Quadric| q.support_bounds().unwrap().unwrap().centre();
+        for (k, b) in p[1..1001].iter().enumerate() {
+            assert!(near(centre(&b.quadric).length(), 2.0));
+            assert_eq!(b.form_factor, if k % 2 == 0 { 0.8 } else { -0.8 });
+            assert!(near(
+                b.quadric.support_bounds().unwrap().unwrap().size().x,
+                0.1
+            ));
+        }
+        for b in &p[1001..] {
+            let c = centre(&b.quadric) - DVec3::Y;
+            assert!(near((c / DVec3::new(1.0, 2.0, 3.0)).length(), 1.0));
+            assert_eq!(b.form_factor, 0.3);
+        }
+        // Deterministic.
+        let again = parse(
+            "[[objects]]\nsphere = { radius = 2 }\n\
+             [[objects.scatter]]\ncount = 10\non_radii = [1, 2, 3]\ncentre = [0, 1, 0]\nradius = 0.1\nf = 0.3\njitter = 0.5\nseed = 7\n",
+        );
+        assert_eq!(&again.objects[0].shape.perturbations[..], &p[1001..]);
+    }
+
+    #[test]
+    fn materials_and_default_material() {
+        let s = parse(
+            "[[materials]]\nname = \"a\"\nalbedo = [0.1, 0.2, 0.3]\n\
+             [[materials]]\nname = \"lamp\"\nemission = [5, 5, 5]\n\
+             [[objects]]\nsphere = { radius = 1 }\nmaterial = \"lamp\"\n\
+             [[objects]]\nname = \"plain\"\nsphere = { radius = 1 }\n\
+             [[objects]]\nsphere = { radius = 1 }\n",
+        );
+        assert_eq!(s.materials.len(), 3);
+        assert_eq!(s.materials[0].albedo, Vec3::new(0.1, 0.2, 0.3));
+        assert_eq!(s.materials[0].emission, Vec3::ZERO);
+        assert_eq!(s.materials[1].albedo, Vec3::splat(0.8));
+        assert_eq!(s.materials[1].emission, Vec3::splat(5.0));
+        assert_eq!(s.materials[2].name, DEFAULT_MATERIAL_NAME);
+        assert_eq!(
+            s.objects.iter().map(|o| o.material).collect::<Vec<_>>(),
+            [1, 2, 2]
+        );
+        assert_eq!(s.objects[1].name, "plain");
+        // No default material when every object names one.
+        let s = parse(
+            "[[materials]]\nname = \"a\"\n[[objects]]\nsphere = { radius = 1 }\nmaterial = \"a\"\n",
+        );
+        assert_eq!(s.materials.len(), 1);
+    }
+
+    #[test]
+    fn lights() {
+        let s = parse(
+            "[[lights]]\ntype = \"point\"\nposition = [1, 2, 3]\nintensity = [10, 10, 10]\n\
+             [[lights]]\ntype = \"sphere\"\nposition = [0, 5, 0]\nradius = 0.5\nradiance = [4, 3, 2]\n",
+        );
+        assert_eq!(
+            s.lights,
+            [
+                Light::Point {
+                    position: DVec3::new(1.0, 2.0, 3.0),
+                    intensity: Vec3::splat(10.0)
+                },
+                Light::Sphere {
+                    centre: DVec3::new(0.0, 5.0, 0.0),
+                    radius: 0.5,
+                    radiance: Vec3::new(4.0, 3.0, 2.0)
+                },
+            ]
+        );
+    }
+
+    #[test]
+    fn camera() {
+        let s = parse_scene(
+            "[camera]\nposition = [1, 2, 3]\nlook_at = [0, 1, 0]\nup = [0, 0, 1]\nfov = 60\n",
+            "t",
+        )
+        .unwrap();
+        assert_eq!(
+            s.camera,
+            Camera {
+                position: DVec3::new(1.0, 2.0, 3.0),
+                look_at: DVec3::Y,
+                up: DVec3::Z,
+                vfov_degrees: 60.0
+            }
+        );
+    }
+
+    #[test]
+    fn default_scene_parses_and_is_bounded() {
+        let s = parse_scene(DEFAULT_SCENE, DEFAULT_SCENE_NAME).unwrap_or_else(|e| panic!("{e}"));
+        assert!(s.objects.len() >= 3);
+        assert!(!s.lights.is_empty());
+        for o in &s.objects {
+            assert!(o.shape.bounds().is_ok(), "{}", o.name);
+        }
+    }
+
+    #[test]
+    fn error_location_counts_characters() {
+        let e = parse_scene(
+            "# é\n[camera]\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\nfov = 200 # é\n",
+            "x.toml",
+        )
+        .unwrap_err();
+        let SceneError::Invalid {
+            line,
+            column,
+            ref field,
+            ..
+        } = e
+        else {
+            panic!("{e}")
+        };
+        assert_eq!((line, column, field.as_str()), (5, 7, "camera.fov"));
+        assert!(
+            e.to_string().contains("\n5 | fov = 200 # é\n  |       ^^^"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,124 @@
+//! Helpers shared by the GPU tests: a validated Vulkan context and
+//! scenes built in code.
+#![allow(dead_code)]
+
+use std::sync::Arc;
+
+use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3};
+use quadray::geometry::{Aabb, FunctionalObject, Perturbation, Quadric};
+use quadray::scene::{Camera, ImageSettings, Light, Material, Scene, SceneObject};
+use quadray::vk::{Context, ValidationCounters};
+
+/// A headless context with the Khronos validation layer on.
+pub fn context() -> Context {
+    let _ = env_logger::builder().is_test(true).filter_level(log::LevelFilter::Warn).try_init();
+    Context::new(true).expect("a Vulkan device with ray queries and the validation layer (run `make setup`)")
+}
+
+/// Fails when the validation layer reported any error; call after dropping
+/// the context so that leaks reported at device destruction count too.
+pub fn assert_no_validation_errors(counters: &Arc<ValidationCounters>) {
+    assert_eq!(counters.errors(), 0, "the validation layer reported errors (see the log above)");
+    println!("validation layer: 0 errors, {} warnings", counters.warnings());
+}
+
+/// `n` bumps spread over a sphere of radius `on` (see `geometry::scatter`).
+pub fn spread_bumps(n: usize, on: f64, r: f64, f: f64, alternate: bool) -> Vec<Perturbation> {
+    quadray::geometry::scatter::spread_bumps(n, DVec3::splat(on), r, f, alternate)
+}
+
+/// An object from its parts.
+pub fn object(name: &str, shape: FunctionalObject, transform: DAffine3) -> SceneObject {
+    SceneObject { name: name.into(), shape, transform, material: 0 }
+}
+
+/// A transform from scale, Euler XYZ angles in degrees, and translation.
+pub fn placement(scale: DVec3, degrees: DVec3, translate: DVec3) -> DAffine3 {
+    let r = DQuat::from_euler(EulerRot::XYZ, degrees.x.to_radians(), degrees.y.to_radians(), degrees.z.to_radians());
+    DAffine3::from_scale_rotation_translation(scale, r, translate)
+}
+
+/// A scene around `objects` with one grey material and one point light.
+pub fn scene_with(objects: Vec<SceneObject>) -> Scene {
+    Scene {
+        image: ImageSettings { width: 64, height: 48, spp: 1, seed: 0, exposure: 0.0 },
+        camera: Camera { position: DVec3::new(0.0, 2.0, 8.0), look_at: DVec3::ZERO, up: DVec3::Y, vfov_degrees: 40.0 },
+        background: Vec3::ZERO,
+        materials: vec![Material { name: "grey".into(), albedo: Vec3::splat(0.8), emission: Vec3::ZERO }],
+        objects,
+        lights: vec![Light::Point { position: DVec3::new(3.0, 6.0, 4.0), intensity: Vec3::splat(40.0) }],
+    }
+}
+
+/// The five-plus objects of the geometry tests: a sphere with 150 bumps and
+/// dents, a clipped one-sheet hyperboloid vessel with bulges, a rotated and
+/// non-uniformly scaled ellipsoid with dents, a clipped floor plane, a
+/// clipped cone with bumps, and a clipped paraboloid given by its coefficients.
+pub fn test_objects() -> Vec<SceneObject> {
+    let sphere = FunctionalObject {
+        base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE),
+        perturbations: spread_bumps(150, 1.0, 0.18, 1.5, true),
+        clip: None,
+    };
+    // One sheet: 1 - (x² + z² - (0.8 y)²) / 0.4², clipped to a vessel.
+    let r2 = 0.4 * 0.4;
+    let hyper = FunctionalObject {
+        base: Quadric::from_coefficients([-1.0 / r2, 0.64 / r2, -1.0 / r2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]),
+        perturbations: (0..20)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 20.0;
+                let y = -0.6 + 1.2 * (i % 5) as f64 / 4.0;
+                let rr = (r2 + 0.64 * y * y).sqrt();
+                let c = DVec3::new(rr * a.cos(), y, rr * a.sin());
+                Perturbation { quadric: Quadric::ellipsoid(c, DVec3::splat(0.25)), form_factor: 4.0 }
+            })
+            .collect(),
+        clip: Some(Aabb::new(DVec3::new(-1.5, -0.8, -1.5), DVec3::new(1.5, 0.8, 1.5))),
+    };
+    let ellipsoid = FunctionalObject {
+        base: Quadric::ellipsoid(DVec3::ZERO, DVec3::new(1.0, 0.5, 0.7)),
+        perturbations: spread_bumps(12, 0.6, 0.3, -2.0, false),
+        clip: None,
+    };
+    let floor = FunctionalObject {
+        base: Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
+        perturbations: vec![],
+        clip: Some(Aabb::new(DVec3::new(-6.0, -0.5, -6.0), DVec3::new(6.0, 0.5, 6.0))),
+    };
+    // Cone around y with half-angle 25°, apex at the origin, clipped below it.
+    let k = 25f64.to_radians().tan().powi(2);
+    let cone = FunctionalObject {
+        base: Quadric::from_coefficients([-1.0, k, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        perturbations: (0..8)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 8.0;
+                let y = -0.9;
+                let rr = k.sqrt() * 0.9;
+                let c = DVec3::new(rr * a.cos(), y, rr * a.sin());
+                Perturbation { quadric: Quadric::ellipsoid(c, DVec3::splat(0.15)), form_factor: 3.0 }
+            })
+            .collect(),
+        clip: Some(Aabb::new(DVec3::new(-1.0, -1.2, -1.0), DVec3::new(1.0, -0.05, 1.0))),
+    };
+    // Paraboloid y = 0.8 (x² + z²), inside above, as general coefficients.
+    let paraboloid = FunctionalObject {
+        base: Quadric::from_coefficients([-0.8, 0.0, -0.8, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0]),
+        perturbations: vec![Perturbation {
+            quadric: Quadric::ellipsoid(DVec3::new(0.3, 0.3, 0.0), DVec3::new(0.3, 0.2, 0.3)),
+            form_factor: -5.0,
+        }],
+        clip: Some(Aabb::new(DVec3::new(-1.0, 0.0, -1.0), DVec3::new(1.0, 0.8, 1.0))),
+    };
+    vec![
+        object("bumpy sphere", sphere, placement(DVec3::ONE, DVec3::ZERO, DVec3::new(0.0, 1.0, 0.0))),
+        object("vessel", hyper, placement(DVec3::ONE, DVec3::new(0.0, 20.0, 0.0), DVec3::new(2.5, 0.8, -1.0))),
+        object(
+            "ellipsoid",
+            ellipsoid,
+            placement(DVec3::new(1.0, 1.5, 0.8), DVec3::new(30.0, 45.0, 10.0), DVec3::new(-2.5, 0.9, 0.5)),
+        ),
+        object("floor", floor, DAffine3::IDENTITY),
+        object("cone", cone, placement(DVec3::ONE, DVec3::new(0.0, 0.0, 180.0), DVec3::new(0.5, 1.3, 2.5))),
+        object("paraboloid", paraboloid, placement(DVec3::splat(1.2), DVec3::new(0.0, 0.0, 0.0), DVec3::new(-1.0, 0.2, -3.0))),
+    ]
+}
