@@ -4,7 +4,8 @@
 //! each perturbation costs.
 //!
 //! `cargo bench --bench perturbations` (add `-- --rays N` to change the ray
-//! count). GPU time comes from timestamps around the probe dispatches; the
+//! count, `-- --max-per-cell K` to change how finely objects are split into
+//! cells). GPU time comes from timestamps around the probe dispatches; the
 //! first run of each configuration is discarded (lavapipe compiles the
 //! shader at its first dispatch), the median of the next runs is kept.
 
@@ -15,7 +16,7 @@ use quadray::geometry::{scatter::spread_bumps, CellParams, FunctionalObject, Qua
 use quadray::passes::gpu::GpuRay;
 use quadray::passes::{GpuScene, ProbePass};
 use quadray::scene::{Camera, ImageSettings, Material, Scene, SceneObject};
-use quadray::shader_interface::NO_HIT;
+use quadray::shader_interface::{INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, NO_HIT};
 use quadray::vk::{Commands, Context};
 
 const COUNTS: [usize; 4] = [0, 10, 100, 1000];
@@ -52,32 +53,56 @@ fn grid_rays(side: usize) -> Vec<GpuRay> {
 }
 
 fn main() {
-    let mut side = 1024;
     let args: Vec<String> = std::env::args().collect();
-    if let Some(i) = args.iter().position(|a| a == "--rays") {
-        let n: usize = args.get(i + 1).and_then(|v| v.parse().ok()).expect("--rays N");
-        side = (n as f64).sqrt().ceil() as usize;
+    let arg = |name: &str| -> Option<usize> {
+        let i = args.iter().position(|a| a == name)?;
+        Some(args.get(i + 1).and_then(|v| v.parse().ok()).unwrap_or_else(|| panic!("{name} takes a number")))
+    };
+    let side = arg("--rays").map_or(1024, |n| (n as f64).sqrt().ceil() as usize);
+    let mut params = CellParams::default();
+    if let Some(k) = arg("--max-per-cell") {
+        params.max_perturbations = k;
     }
     let ctx = Context::new(false).expect("a Vulkan device with ray queries (run `make setup`)");
     let device = Arc::clone(&ctx.device);
     let mut cmds = Commands::new(&device).unwrap();
     let rays = grid_rays(side);
-    println!("device: {}; {} rays per run, median of {} runs after a discarded first run\n", device.name, rays.len(), RUNS);
     println!(
-        "{:>13} {:>6} {:>8} {:>10} {:>12} {:>10} {:>14} {:>16}",
-        "perturbations", "cells", "hit %", "ms", "Mrays/s", "time ratio", "table B/pert", "accel B (total)"
+        "device: {}; {} rays per run, median of {} runs after a discarded first run; cells split to <= {} perturbations\n",
+        device.name,
+        rays.len(),
+        RUNS,
+        params.max_perturbations
+    );
+    println!(
+        "{:>13} {:>6} {:>6} {:>9} {:>9} {:>7} {:>10} {:>10} {:>12} {:>12}",
+        "perturbations",
+        "cells",
+        "hit %",
+        "ms",
+        "Mrays/s",
+        "ratio",
+        "boxes ms",
+        "base ms",
+        "table B/pert",
+        "accel bytes"
     );
     let mut base_ms = None;
     let mut base_table = 0u64;
     for n in COUNTS {
         let scene = sphere_scene(n);
-        let gpu = GpuScene::new(&device, &mut cmds, &scene, &CellParams::default()).unwrap();
-        let probe = ProbePass::new(&device, &gpu, &rays).unwrap();
-        let (hits, _) = probe.run(&mut cmds).unwrap();
+        let gpu = GpuScene::new(&device, &mut cmds, &scene, &params).unwrap();
+        let timed = |mode: u32, cmds: &mut Commands| {
+            let probe = ProbePass::new(&device, &gpu, &rays, mode).unwrap();
+            let (hits, _) = probe.run(cmds).unwrap(); // discarded: the shader compiles here
+            let mut times: Vec<f64> = (0..RUNS).map(|_| probe.run(cmds).unwrap().1 * 1e-6).collect();
+            times.sort_by(f64::total_cmp);
+            (hits, times[RUNS / 2])
+        };
+        let (hits, ms) = timed(INTERSECT_FULL, &mut cmds);
+        let (_, boxes_ms) = timed(INTERSECT_BOXES, &mut cmds);
+        let (_, base_only_ms) = timed(INTERSECT_BASE, &mut cmds);
         let hit_fraction = hits.iter().filter(|h| h.object != NO_HIT).count() as f64 / hits.len() as f64;
-        let mut times: Vec<f64> = (0..RUNS).map(|_| probe.run(&mut cmds).unwrap().1 * 1e-6).collect();
-        times.sort_by(f64::total_cmp);
-        let ms = times[RUNS / 2];
         let base = *base_ms.get_or_insert(ms);
         let stats = gpu.stats;
         if n == 0 {
@@ -85,18 +110,22 @@ fn main() {
         }
         let per_pert = if n > 0 { format!("{:.1}", (stats.table_bytes - base_table) as f64 / n as f64) } else { "-".into() };
         println!(
-            "{:>13} {:>6} {:>8.1} {:>10.2} {:>12.2} {:>10.2} {:>14} {:>16}",
+            "{:>13} {:>6} {:>6.1} {:>9.2} {:>9.2} {:>7.2} {:>10.2} {:>10.2} {:>12} {:>12}",
             n,
             stats.cells,
             100.0 * hit_fraction,
             ms,
             rays.len() as f64 / (ms * 1e3),
             ms / base,
+            boxes_ms,
+            base_only_ms,
             per_pert,
             stats.accel_bytes
         );
     }
-    println!("\ntime ratio: GPU time / GPU time with 0 perturbations (target: <= 3 at 1000).");
+    println!("\nratio: GPU time / GPU time with 0 perturbations (target: <= 3 at 1000).");
+    println!("boxes ms: every candidate box is a hit where the ray enters it (traversal cost alone).");
+    println!("base ms: perturbations ignored, the base quadric's roots in each box (cells without perturbation work).");
     println!("table B/pert: bytes of perturbation, cell and cell-list tables added per perturbation (target: <= 64),");
     println!("              acceleration structures listed separately.");
 }

@@ -18,13 +18,17 @@ struct Quadric {
 struct Object {
     Quadric base;
     uint material;
-    uint pad;
+    uint firstCell;  // cell of primitive 0 of the object's bottom level
 };
 
+// A perturbation f · max(Q, 0)³. Q is stored relative to `centre`, the centre
+// of a sphere of `radius` that bounds its support {Q >= 0}; radius < 0 marks
+// an unbounded support (centre 0).
 struct Perturbation {
     Quadric q;
     float f;
-    uint pad;
+    float centre[3];
+    float radius;
 };
 
 struct Cell {
@@ -32,8 +36,6 @@ struct Cell {
     float hi[3];
     uint first;   // into the cell lists
     uint count;
-    uint object;
-    uint pad;
 };
 
 struct Material {

@@ -12,6 +12,14 @@
 #include "interface.glsl"
 #include "roots.glsl"
 
+// Specialisation constant for cost breakdowns (benchmarks): INTERSECT_FULL,
+// INTERSECT_BOXES (each candidate box reports a hit where the ray enters it:
+// traversal cost only) or INTERSECT_BASE (perturbations ignored: the base
+// quadric's roots in each box).
+layout(constant_id = 0) const uint INTERSECT_MODE = INTERSECT_FULL;
+
+vec3 v3(float a[3]) { return vec3(a[0], a[1], a[2]); }
+
 float quadricAt(Quadric q, vec3 p) {
     return q.a[0] * p.x * p.x + q.a[1] * p.y * p.y + q.a[2] * p.z * p.z
          + 2.0 * (q.a[3] * p.x * p.y + q.a[4] * p.y * p.z + q.a[5] * p.x * p.z)
@@ -56,9 +64,55 @@ void addCube(inout float c[7], vec3 q, float f) {
     c[6] += f * (s4 * q.z);
 }
 
+// First root of x + y s + z s² in [lo, hi] (closed form), or NO_ROOT.
+float quadraticFirstRoot(vec3 q, float lo, float hi) {
+    vec2 r = quadraticRoots(q);
+    if (r.x >= lo && r.x <= hi) return r.x;
+    if (r.y >= lo && r.y <= hi) return r.y;
+    return NO_ROOT;
+}
+
+// True when x + y s + z s² > 0 somewhere in [lo, hi].
+bool positiveSomewhere(vec3 q, float lo, float hi) {
+    if (q.x + lo * (q.y + lo * q.z) > 0.0 || q.x + hi * (q.y + hi * q.z) > 0.0) return true;
+    if (q.z >= 0.0) return false;
+    float v = -q.y / (2.0 * q.z);
+    return v > lo && v < hi && q.x + v * (q.y + v * q.z) > 0.0;
+}
+
+// True when perturbation k is non-zero somewhere on p + s d, s in [lo, hi]:
+// first a cheap test against its bounding sphere, then its quadric.
+bool perturbationOnSegment(uint k, vec3 p, vec3 d, float lo, float hi) {
+    vec3 h = p - v3(perturbations[k].centre);
+    float radius = perturbations[k].radius;
+    if (radius >= 0.0) {
+        float dd = dot(d, d), b = dot(h, d);
+        float disc = b * b - dd * (dot(h, h) - radius * radius);
+        if (disc < 0.0) return false;
+        float sq = sqrt(disc);
+        if ((-b + sq) < lo * dd || (-b - sq) > hi * dd) return false;
+    }
+    return positiveSomewhere(quadricAlongRay(perturbations[k].q, h, d), lo, hi);
+}
+
+// Perturbations of one cell that are positive somewhere on the ray segment;
+// only they cut the segment into pieces and add terms to F'. Their
+// restrictions to the ray are kept in registers.
+const uint MAX_RELEVANT = 8u;
+
+// q(s) re-expanded around s = m: q(m + u) as a quadratic in u.
+vec3 shiftQuadratic(vec3 q, float m) {
+    return vec3(q.x + m * (q.y + m * q.z), q.y + 2.0 * m * q.z, q.z);
+}
+
+// Restriction of perturbation k to p + s d.
+vec3 perturbationAlongRay(uint k, vec3 p, vec3 d) {
+    return quadricAlongRay(perturbations[k].q, p - v3(perturbations[k].centre), d);
+}
+
 // First t in [tlo, thi] (and inside the cell) where F' = 0 along o + t d, in
 // the object's frame; NO_ROOT if none.
-float cellFirstRoot(uint cellIndex, vec3 o, vec3 d, float tlo, float thi) {
+float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, float tlo, float thi) {
     Cell cell = cells[cellIndex];
     vec3 inv = 1.0 / d;
     vec3 ta = (vec3(cell.lo[0], cell.lo[1], cell.lo[2]) - o) * inv;
@@ -68,47 +122,91 @@ float cellFirstRoot(uint cellIndex, vec3 o, vec3 d, float tlo, float thi) {
     float t1 = min(min(min(tmx.x, tmx.y), tmx.z), thi);
     if (!(t0 <= t1)) return NO_ROOT;
 
-    // Breakpoints are found in s = t - tc around the segment's middle; each
-    // piece's polynomial is expanded around the piece's own middle, so that
-    // its coefficients stay well conditioned in f32.
+    if (INTERSECT_MODE == INTERSECT_BOXES) return t0;
+
+    // Work in s = t - tc around the segment's middle.
     float tc = 0.5 * (t0 + t1);
     vec3 p = o + tc * d;
-    float s1 = t1 - tc;
-    Quadric baseQ = objects[cell.object].base;
+    float s0 = t0 - tc, s1 = t1 - tc;
+    vec3 base = quadricAlongRay(objects[object].base, p, d);
+    if (INTERSECT_MODE == INTERSECT_BASE || cell.count == 0u) {
+        float r = quadraticFirstRoot(base, s0, s1);
+        return r == NO_ROOT ? NO_ROOT : tc + r;
+    }
 
-    float sa = t0 - tc;
-    for (uint piece = 0; piece <= 2u * cell.count && sa < s1; ++piece) {
-        // The next breakpoint after sa: the end of this polynomial piece.
-        float sb = s1;
-        for (uint i = 0; i < cell.count; ++i) {
-            vec2 r = quadraticRoots(quadricAlongRay(perturbations[cellLists[cell.first + i]].q, p, d));
-            if (r.x > sa && r.x < sb) sb = r.x;
-            if (r.y > sa && r.y < sb) sb = r.y;
+    // Gather the relevant perturbations. With more than MAX_RELEVANT of them
+    // the segment is split in halves, each gathered again; where even a short
+    // segment has more (many overlapping perturbations), the cell's whole list
+    // is used, read from memory (slower, still exact).
+    float segLo = s0;
+    for (int split = 0; split < 64 && segLo < s1; ++split) {
+        float segHi = s1;
+        vec3 relQ[MAX_RELEVANT];
+        float relF[MAX_RELEVANT];
+        uint nrel = 0u;
+        bool overflow = false;
+        for (int attempt = 0; attempt < 8; ++attempt) {
+            nrel = 0u;
+            overflow = false;
+            for (uint i = 0; i < cell.count; ++i) {
+                uint k = cellLists[cell.first + i];
+                if (perturbationOnSegment(k, p, d, segLo, segHi)) {
+                    if (nrel == MAX_RELEVANT) { overflow = true; break; }
+                    relQ[nrel] = perturbationAlongRay(k, p, d);
+                    relF[nrel] = perturbations[k].f;
+                    ++nrel;
+                }
+            }
+            if (!overflow || attempt == 7) break;
+            segHi = 0.5 * (segLo + segHi);
         }
-        float sm = 0.5 * (sa + sb);
-        vec3 pm = p + sm * d;
-        vec3 base = quadricAlongRay(baseQ, pm, d);
-        float c[7] = float[7](base.x, base.y, base.z, 0.0, 0.0, 0.0, 0.0);
-        for (uint i = 0; i < cell.count; ++i) {
-            Perturbation pt = perturbations[cellLists[cell.first + i]];
-            vec3 q = quadricAlongRay(pt.q, pm, d);
-            if (q.x > 0.0) addCube(c, q, pt.f);
+        bool all = overflow;
+        if (all) nrel = cell.count;
+
+        // Walk the pieces of [segLo, segHi] between the breakpoints; on each,
+        // F' is a polynomial of degree <= 6, expanded around the piece's own
+        // middle so that its coefficients stay well conditioned in f32.
+        float sa = segLo;
+        for (uint piece = 0; piece <= 2u * nrel && sa < segHi; ++piece) {
+            float sb = segHi;
+            for (uint i = 0; i < nrel; ++i) {
+                vec3 q = all ? perturbationAlongRay(cellLists[cell.first + i], p, d) : relQ[i];
+                vec2 r = quadraticRoots(q);
+                if (r.x > sa && r.x < sb) sb = r.x;
+                if (r.y > sa && r.y < sb) sb = r.y;
+            }
+            float sm = 0.5 * (sa + sb);
+            vec3 b = shiftQuadratic(base, sm);
+            float c[7] = float[7](b.x, b.y, b.z, 0.0, 0.0, 0.0, 0.0);
+            bool any = false;
+            for (uint i = 0; i < nrel; ++i) {
+                uint k = all ? cellLists[cell.first + i] : 0u;
+                vec3 q = shiftQuadratic(all ? perturbationAlongRay(k, p, d) : relQ[i], sm);
+                if (q.x > 0.0) {
+                    addCube(c, q, all ? perturbations[k].f : relF[i]);
+                    any = true;
+                }
+            }
+            float r = any ? firstRoot(c, sa - sm, sb - sm) : quadraticFirstRoot(b, sa - sm, sb - sm);
+            if (r != NO_ROOT) return tc + sm + r;
+            sa = sb;
         }
-        float r = firstRoot(c, sa - sm, sb - sm);
-        if (r != NO_ROOT) return tc + sm + r;
-        sa = sb;
+        segLo = segHi;
     }
     return NO_ROOT;
 }
 
 // ∇F' at p (object frame), with the perturbations listed by the cell.
-vec3 cellGradient(uint cellIndex, vec3 p) {
+vec3 cellGradient(uint object, uint cellIndex, vec3 p) {
     Cell cell = cells[cellIndex];
-    vec3 g = quadricGradient(objects[cell.object].base, p);
+    vec3 g = quadricGradient(objects[object].base, p);
     for (uint i = 0; i < cell.count; ++i) {
-        Perturbation pt = perturbations[cellLists[cell.first + i]];
-        float q = quadricAt(pt.q, p);
-        if (q > 0.0) g += 3.0 * pt.f * q * q * quadricGradient(pt.q, p);
+        uint k = cellLists[cell.first + i];
+        vec3 h = p - v3(perturbations[k].centre);
+        float radius = perturbations[k].radius;
+        if (radius >= 0.0 && dot(h, h) > radius * radius) continue;
+        float q = quadricAt(perturbations[k].q, h);
+        if (q > 0.0) g += 3.0 * perturbations[k].f * q * q * quadricGradient(perturbations[k].q, h);
     }
     return g;
 }
@@ -119,11 +217,11 @@ struct SceneHit {
     vec3 normal;    // world space, outward (-∇F'), unit length
 };
 
-// The cell (index into cells[]) of the candidate or committed intersection;
-// `committed` must be a literal.
-#define candidateCell(rq, committed) \
-    (uint(rayQueryGetIntersectionInstanceCustomIndexEXT(rq, committed)) \
-     + uint(rayQueryGetIntersectionPrimitiveIndexEXT(rq, committed)))
+// The object (instance custom index) and its cell (index into cells[]) of
+// the candidate or committed intersection; `committed` must be a literal.
+#define candidateObject(rq, committed) uint(rayQueryGetIntersectionInstanceCustomIndexEXT(rq, committed))
+#define candidateCell(rq, object, committed) \
+    (objects[object].firstCell + uint(rayQueryGetIntersectionPrimitiveIndexEXT(rq, committed)))
 
 // Runs the candidate loop: for each AABB, the first root in the cell.
 void proceedFunctional(rayQueryEXT rq, float tmin, float tmax) {
@@ -132,7 +230,8 @@ void proceedFunctional(rayQueryEXT rq, float tmin, float tmax) {
         if (rayQueryGetIntersectionTypeEXT(rq, false) != gl_RayQueryCandidateIntersectionAABBEXT) continue;
         vec3 oo = rayQueryGetIntersectionObjectRayOriginEXT(rq, false);
         vec3 od = rayQueryGetIntersectionObjectRayDirectionEXT(rq, false);
-        float t = cellFirstRoot(candidateCell(rq, false), oo, od, tmin, best);
+        uint object = candidateObject(rq, false);
+        float t = cellFirstRoot(object, candidateCell(rq, object, false), oo, od, tmin, best);
         if (t != NO_ROOT && t <= best) {
             best = t;
             rayQueryGenerateIntersectionEXT(rq, t);
@@ -151,11 +250,11 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
     h.normal = vec3(0.0);
     if (rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionGeneratedEXT) {
         h.t = rayQueryGetIntersectionTEXT(rq, true);
-        uint cell = candidateCell(rq, true);
-        h.object = cells[cell].object;
+        h.object = candidateObject(rq, true);
+        uint cell = candidateCell(rq, h.object, true);
         vec3 oo = rayQueryGetIntersectionObjectRayOriginEXT(rq, true);
         vec3 od = rayQueryGetIntersectionObjectRayDirectionEXT(rq, true);
-        vec3 g = cellGradient(cell, oo + h.t * od);
+        vec3 g = cellGradient(h.object, cell, oo + h.t * od);
         mat4x3 w2o = rayQueryGetIntersectionWorldToObjectEXT(rq, true);
         vec3 n = -(transpose(mat3(w2o)) * g);
         float len = length(n);

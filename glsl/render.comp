@@ -23,7 +23,7 @@ layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
 } frame;
 
 // rgb: summed radiance, a: sample count.
-layout(set = 0, binding = BINDING_ACCUM, scalar) buffer Accum { vec4 accum[]; };
+layout(set = 0, binding = BINDING_ACCUM, rgba32f) uniform image2D accum;
 
 struct Aov {
     float depth;
@@ -40,8 +40,6 @@ layout(push_constant, scalar) uniform Push {
 } pc;
 
 const float PI = 3.14159265358979;
-
-vec3 v3(float a[3]) { return vec3(a[0], a[1], a[2]); }
 
 vec3 cameraRay(vec2 pixel) {
     vec2 ndc = vec2(2.0 * pixel.x / float(frame.width) - 1.0, 1.0 - 2.0 * pixel.y / float(frame.height));
@@ -157,5 +155,6 @@ void main() {
     }
     // No NaN or Inf ever leaves the renderer.
     if (any(isnan(radiance)) || any(isinf(radiance))) radiance = vec3(0.0);
-    accum[idx] += vec4(radiance, 1.0);
+    ivec2 at = ivec2(pix);
+    imageStore(accum, at, imageLoad(accum, at) + vec4(radiance, 1.0));
 }

@@ -49,7 +49,8 @@ struct RenderArgs {
     #[arg(long)]
     half: bool,
     /// Enable the Khronos validation layer; the command fails if it reports errors.
-    #[arg(long, env = "QUADRAY_VALIDATION")]
+    /// QUADRAY_VALIDATION=1 (or true/yes/on) in the environment does the same.
+    #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     validation: bool,
     /// Print progress even when stderr is not a terminal.
     #[arg(long)]

@@ -56,8 +56,15 @@ pub fn tone_map(out: &RenderOutput, exposure: f32) -> Vec<u8> {
 pub fn write_png(out: &RenderOutput, exposure: f32, path: &Path) -> io::Result<()> {
     let pixels = tone_map(out, exposure);
     write_atomically(path, |tmp| {
-        image::save_buffer_with_format(tmp, &pixels, out.width, out.height, image::ColorType::Rgb8, image::ImageFormat::Png)
-            .map_err(io::Error::other)
+        image::save_buffer_with_format(
+            tmp,
+            &pixels,
+            out.width,
+            out.height,
+            image::ColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(io::Error::other)
     })
 }
 

@@ -37,3 +37,9 @@ pub const LIGHT_POINT: u32 = 0;
 pub const LIGHT_SPHERE: u32 = 1;
 /// Object index written for a ray that hits nothing.
 pub const NO_HIT: u32 = 4294967295;
+/// Intersection mode: exact first root of F' (the renderer's mode).
+pub const INTERSECT_FULL: u32 = 0;
+/// Intersection mode: every candidate box is a hit where the ray enters it.
+pub const INTERSECT_BOXES: u32 = 1;
+/// Intersection mode: perturbations ignored (base quadric only).
+pub const INTERSECT_BASE: u32 = 2;

@@ -18,7 +18,7 @@ use quadray::geometry::{reference, Aabb, CellParams};
 use quadray::passes::gpu::{GpuHit, GpuRay};
 use quadray::passes::{GpuScene, ProbePass};
 use quadray::scene::SceneObject;
-use quadray::shader_interface::NO_HIT;
+use quadray::shader_interface::{INTERSECT_FULL, NO_HIT};
 use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -243,7 +243,7 @@ fn gpu_hits_match_the_f64_reference() {
         ("on-surface", &on_surface, ON_SURFACE_MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES),
         ("grazing", &grazing, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES),
     ] {
-        let probe = ProbePass::new(&ctx.device, &gpu_scene, rays).unwrap();
+        let probe = ProbePass::new(&ctx.device, &gpu_scene, rays, INTERSECT_FULL).unwrap();
         let (hits, _) = probe.run(&mut cmds).unwrap();
         let refs: Vec<Option<RefHit>> = rays
             .iter()

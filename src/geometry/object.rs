@@ -60,6 +60,9 @@ pub struct CellParams {
     pub max_perturbations: usize,
     /// Split depth limit (binary splits).
     pub max_depth: u32,
+    /// A cell's box is shrunk to the sub-boxes, down to this many halvings,
+    /// that may hold surface.
+    pub tighten_depth: u32,
     /// Cells are grown by this fraction of the object's box diagonal so that
     /// f32 slab tests on the GPU leave no gap between neighbours.
     pub padding: f64,
@@ -67,7 +70,7 @@ pub struct CellParams {
 
 impl Default for CellParams {
     fn default() -> Self {
-        Self { max_perturbations: 8, max_depth: 18, padding: 1e-5 }
+        Self { max_perturbations: 16, max_depth: 18, tighten_depth: 6, padding: 1e-5 }
     }
 }
 
@@ -168,13 +171,14 @@ impl FunctionalObject {
         Ok(out)
     }
 
-    fn split(&self, bx: Aabb, candidates: &[u32], depth: u32, pad: f64, params: &CellParams, out: &mut Vec<Cell>) {
-        let padded = bx.padded(pad);
+    /// The perturbations that can be non-zero in `bx` (from `candidates`), or
+    /// `None` when interval bounds prove F' has no zero in `bx`.
+    fn active_in(&self, bx: &Aabb, candidates: &[u32]) -> Option<Vec<u32>> {
         let mut active = Vec::new();
-        let (mut lo, mut hi) = self.base.range_over(&padded);
+        let (mut lo, mut hi) = self.base.range_over(bx);
         for &i in candidates {
             let p = &self.perturbations[i as usize];
-            let (qlo, qhi) = p.quadric.range_over(&padded);
+            let (qlo, qhi) = p.quadric.range_over(bx);
             if qhi <= 0.0 {
                 continue;
             }
@@ -188,29 +192,53 @@ impl FunctionalObject {
                 hi += p.form_factor * rlo;
             }
         }
-        if lo > 0.0 || hi < 0.0 {
-            return;
-        }
+        (lo <= 0.0 && hi >= 0.0).then_some(active)
+    }
+
+    fn split(&self, bx: Aabb, candidates: &[u32], depth: u32, pad: f64, params: &CellParams, out: &mut Vec<Cell>) {
+        let Some(active) = self.active_in(&bx.padded(pad), candidates) else { return };
         if active.len() <= params.max_perturbations || depth >= params.max_depth {
-            out.push(Cell { bounds: padded, perturbations: active });
+            // The list holds for the whole padded box, so also for any box in it.
+            if let Some(tight) = self.tighten(bx, &active, params.tighten_depth) {
+                out.push(Cell { bounds: tight.padded(pad), perturbations: active });
+            }
             return;
         }
-        let size = bx.size();
-        let axis = if size.x >= size.y && size.x >= size.z {
-            0
-        } else if size.y >= size.z {
-            1
-        } else {
-            2
-        };
-        let mid = bx.centre()[axis];
-        let mut left = bx;
-        let mut right = bx;
-        left.max[axis] = mid;
-        right.min[axis] = mid;
+        let (left, right) = halves(&bx);
         self.split(left, &active, depth + 1, pad, params, out);
         self.split(right, &active, depth + 1, pad, params, out);
     }
+
+    /// The union of the sub-boxes of `bx`, down to `depth` halvings, that may
+    /// hold surface: a tighter box for a cell, so that fewer rays visit it.
+    fn tighten(&self, bx: Aabb, active: &[u32], depth: u32) -> Option<Aabb> {
+        self.active_in(&bx, active)?;
+        if depth == 0 {
+            return Some(bx);
+        }
+        let (left, right) = halves(&bx);
+        match (self.tighten(left, active, depth - 1), self.tighten(right, active, depth - 1)) {
+            (Some(a), Some(b)) => Some(a.union(&b)),
+            (a, b) => a.or(b),
+        }
+    }
+}
+
+/// The two halves of a box, split across its longest axis.
+fn halves(bx: &Aabb) -> (Aabb, Aabb) {
+    let size = bx.size();
+    let axis = if size.x >= size.y && size.x >= size.z {
+        0
+    } else if size.y >= size.z {
+        1
+    } else {
+        2
+    };
+    let mid = bx.centre()[axis];
+    let (mut left, mut right) = (*bx, *bx);
+    left.max[axis] = mid;
+    right.min[axis] = mid;
+    (left, right)
 }
 
 #[cfg(test)]
@@ -267,7 +295,7 @@ mod tests {
         }
         let cells = o.cells(&CellParams::default()).unwrap();
         assert!(cells.len() > 8);
-        assert!(cells.iter().all(|c| c.perturbations.len() <= 8));
+        assert!(cells.iter().all(|c| c.perturbations.len() <= CellParams::default().max_perturbations));
         // Points on the perturbed surface (found along radial rays) must lie
         // in some cell, and that cell must list every perturbation active there.
         for i in 0..2000 {

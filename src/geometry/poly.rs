@@ -5,8 +5,9 @@
 //! for Graphics" (HPG 2022): the roots of p' split [lo, hi] into intervals on
 //! which p is monotonic, so each holds at most one root, found by a
 //! Newton iteration safeguarded by bisection. The derivatives' roots are
-//! found the same way, from the highest derivative down. `glsl/roots.glsl`
-//! is the f32 twin of this file.
+//! found the same way, from the highest derivative down. The GPU
+//! (`glsl/roots.glsl`) isolates roots by Bernstein subdivision instead, so
+//! the reference and the GPU check each other with different methods.
 
 /// Highest supported degree: a cubed quadric.
 pub const MAX_DEGREE: usize = 6;

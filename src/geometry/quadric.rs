@@ -129,6 +129,41 @@ impl Quadric {
         Some(Some(Aabb::new(centre - half - pad, centre + half + pad)))
     }
 
+    /// A sphere (centre, radius) holding `{q >= 0}` when that set is bounded
+    /// and not empty. The radius is sqrt(q(m) · λ_max((-A)⁻¹)), with the
+    /// eigenvalue found by power iteration and rounded up.
+    pub fn support_sphere(&self) -> Option<(DVec3, f64)> {
+        let neg = -self.a;
+        if !is_positive_definite(&neg) {
+            return None;
+        }
+        let inv = neg.inverse();
+        let centre = 0.5 * (inv * self.b);
+        let top = self.eval(centre);
+        if top < 0.0 {
+            return None;
+        }
+        let mut v = DVec3::new(1.0, 0.7, 0.3);
+        let mut lambda = 0.0;
+        for _ in 0..100 {
+            let w = inv * v;
+            let l = w.length();
+            if l == 0.0 {
+                break;
+            }
+            lambda = l / v.length();
+            v = w / l;
+        }
+        // Power iteration approaches λ_max from below: bound it by the largest
+        // diagonal-dominance (Gershgorin) estimate when that is smaller.
+        let gershgorin = (0..3)
+            .map(|i| (0..3).map(|j| inv.col(j)[i].abs()).sum::<f64>())
+            .fold(0.0f64, f64::max);
+        let lambda = (lambda * (1.0 + 1e-6)).min(gershgorin).max(lambda);
+        let radius = (top * lambda).sqrt() * (1.0 + 1e-6) + 1e-12 * centre.length();
+        Some((centre, radius))
+    }
+
     /// A conservative range of values over `bx`.
     ///
     /// Centred form around the box's middle m: q(m + h) = q(m) + Σ_i (g_i h_i
@@ -208,6 +243,20 @@ mod tests {
         let b = q.support_bounds().unwrap().unwrap();
         assert!((b.min - DVec3::new(0.5, 0.5, 0.5)).abs().max_element() < 1e-9);
         assert!((b.max - DVec3::new(1.5, 3.5, 5.5)).abs().max_element() < 1e-9);
+    }
+
+    #[test]
+    fn support_sphere_bounds_a_rotated_ellipsoid() {
+        let e = Quadric::ellipsoid(DVec3::new(0.5, -1.0, 2.0), DVec3::new(0.3, 0.8, 0.5));
+        let m = DAffine3::from_rotation_translation(
+            glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.4, 1.0, -0.3),
+            DVec3::new(1.0, 2.0, 3.0),
+        );
+        let q = e.transformed(&m);
+        let (c, r) = q.support_sphere().unwrap();
+        assert!((r - 0.8).abs() < 1e-5, "radius {r}");
+        assert!((c - m.transform_point3(DVec3::new(0.5, -1.0, 2.0))).length() < 1e-9);
+        assert!(Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0]).support_sphere().is_none());
     }
 
     #[test]

@@ -3,7 +3,9 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::geometry::Quadric;
+use glam::{DAffine3, DVec3};
+
+use crate::geometry::{Perturbation, Quadric};
 
 /// `Quadric` in interface.glsl: A's six entries, b, c.
 #[repr(C)]
@@ -36,20 +38,33 @@ pub struct GpuObject {
     pub base: GpuQuadric,
     /// Material index.
     pub material: u32,
-    /// Padding.
-    pub pad: u32,
+    /// Index of the object's first cell in the cell table.
+    pub first_cell: u32,
 }
 
 /// `Perturbation` in interface.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuPerturbation {
-    /// Perturbing quadric in the object frame.
+    /// Perturbing quadric, relative to `centre`: Q(p) = q(p - centre).
     pub q: GpuQuadric,
     /// Form factor.
     pub f: f32,
-    /// Padding.
-    pub pad: u32,
+    /// Centre of a sphere bounding the support {Q >= 0} (object frame).
+    pub centre: [f32; 3],
+    /// Radius of that sphere; negative when the support is unbounded.
+    pub radius: f32,
+}
+
+impl From<&Perturbation> for GpuPerturbation {
+    fn from(p: &Perturbation) -> Self {
+        let (centre, radius) = match p.quadric.support_sphere() {
+            Some((c, r)) => (c, r as f32),
+            None => (DVec3::ZERO, -1.0),
+        };
+        let local = p.quadric.transformed(&DAffine3::from_translation(-centre));
+        Self { q: GpuQuadric::from(&local), f: p.form_factor as f32, centre: centre.as_vec3().to_array(), radius }
+    }
 }
 
 /// `Cell` in interface.glsl: one procedural AABB.
@@ -64,10 +79,6 @@ pub struct GpuCell {
     pub first: u32,
     /// Number of perturbations.
     pub count: u32,
-    /// Object index.
-    pub object: u32,
-    /// Padding.
-    pub pad: u32,
 }
 
 /// `Material` in interface.glsl.
@@ -189,8 +200,8 @@ pub struct ProbePush {
 const _: () = {
     assert!(std::mem::size_of::<GpuQuadric>() == 40);
     assert!(std::mem::size_of::<GpuObject>() == 48);
-    assert!(std::mem::size_of::<GpuPerturbation>() == 48);
-    assert!(std::mem::size_of::<GpuCell>() == 40);
+    assert!(std::mem::size_of::<GpuPerturbation>() == 60);
+    assert!(std::mem::size_of::<GpuCell>() == 32);
     assert!(std::mem::size_of::<GpuMaterial>() == 32);
     assert!(std::mem::size_of::<GpuLight>() == 32);
     assert!(std::mem::size_of::<GpuFrame>() == 76);

@@ -22,8 +22,9 @@ pub struct ProbePass {
 }
 
 impl ProbePass {
-    /// Uploads `rays` and binds them with the scene.
-    pub fn new(device: &Arc<Device>, scene: &GpuScene, rays: &[GpuRay]) -> Result<Self, RenderError> {
+    /// Uploads `rays` and binds them with the scene; `mode` is one of the
+    /// `INTERSECT_*` constants (`INTERSECT_FULL` for the real intersection).
+    pub fn new(device: &Arc<Device>, scene: &GpuScene, rays: &[GpuRay], mode: u32) -> Result<Self, RenderError> {
         let kinds = [
             BindingKind::AccelerationStructure,
             BindingKind::StorageBuffer,
@@ -34,7 +35,7 @@ impl ProbePass {
             BindingKind::StorageBuffer,
         ];
         let pipeline =
-            ComputePipeline::new(device, &shaders::probe(), &kinds, std::mem::size_of::<ProbePush>() as u32, &[])?;
+            ComputePipeline::new(device, &shaders::probe(), &kinds, std::mem::size_of::<ProbePush>() as u32, &[mode])?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::new(
             device,

@@ -9,7 +9,7 @@ use super::gpu::{GpuAov, GpuFrame, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use crate::scene::Scene;
 use crate::shader_interface::RENDER_GROUP;
-use crate::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::vk::{full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation};
 use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
@@ -57,14 +57,20 @@ pub fn render(
         light_count: gpu.light_count,
     };
     let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
-    let mut accum = Buffer::new(
+    let accum = Image::new(
         device,
         "accumulation",
+        vk::Extent2D { width, height },
+        vk::Format::R32G32B32A32_SFLOAT,
+        vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
+    )?;
+    let readback = Buffer::new(
+        device,
+        "accumulation readback",
         pixels * 16,
-        vk::BufferUsageFlags::STORAGE_BUFFER,
+        vk::BufferUsageFlags::TRANSFER_DST,
         MemoryLocation::GpuToCpu,
     )?;
-    accum.write(0, &vec![0u8; (pixels * 16) as usize]);
     let aov = Buffer::new(
         device,
         "aov",
@@ -74,7 +80,8 @@ pub fn render(
     )?;
 
     let mut kinds = vec![BindingKind::AccelerationStructure];
-    kinds.extend([BindingKind::StorageBuffer; 9]);
+    kinds.extend([BindingKind::StorageBuffer; 7]);
+    kinds.extend([BindingKind::StorageImage, BindingKind::StorageBuffer]);
     let pipeline =
         ComputePipeline::new(device, &shaders::render(), &kinds, std::mem::size_of::<RenderPush>() as u32, &[])?;
     let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
@@ -87,7 +94,7 @@ pub fn render(
         Binding::Buffer(&gpu.materials),
         Binding::Buffer(&gpu.lights),
         Binding::Buffer(&frame_buf),
-        Binding::Buffer(&accum),
+        Binding::Image(&accum),
         Binding::Buffer(&aov),
     ]);
 
@@ -98,6 +105,10 @@ pub fn render(
         })
         .collect();
     let total = tiles.len() as u64 * spp as u64;
+    cmds.run(|_, cmd| {
+        accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
+        accum.clear(cmd);
+    })?;
     let start = Instant::now();
     let mut done = 0;
     for sample in 0..spp {
@@ -108,7 +119,9 @@ pub fn render(
                 sample_index: sample,
                 write_aov: (sample == 0) as u32,
             };
-            cmds.run(|_, cmd| {
+            cmds.run(|d, cmd| {
+                // Earlier submissions' writes to the accumulation image must be visible.
+                full_barrier(d, cmd);
                 pipeline.dispatch(
                     cmd,
                     bytemuck::bytes_of(&push),
@@ -121,7 +134,12 @@ pub fn render(
     }
     let seconds = start.elapsed().as_secs_f64();
 
-    let sums: Vec<[f32; 4]> = accum.read();
+    cmds.run(|d, cmd| {
+        full_barrier(d, cmd);
+        accum.copy_to_buffer(cmd, &readback);
+        full_barrier(d, cmd);
+    })?;
+    let sums: Vec<[f32; 4]> = readback.read();
     let radiance = sums[..pixels as usize]
         .iter()
         .map(|s| {

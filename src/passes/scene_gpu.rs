@@ -109,13 +109,17 @@ impl GpuScene {
                     .shape
                     .perturbations
                     .iter()
-                    .map(|p| GpuPerturbation { q: GpuQuadric::from(&p.quadric), f: p.form_factor as f32, pad: 0 }),
+                    .map(GpuPerturbation::from),
             );
-            objects.push(GpuObject { base: GpuQuadric::from(&object.shape.base), material: object.material as u32, pad: 0 });
+            let first_cell = cells.len() as u32;
+            objects.push(GpuObject {
+                base: GpuQuadric::from(&object.shape.base),
+                material: object.material as u32,
+                first_cell,
+            });
             if object_cells.is_empty() {
                 continue;
             }
-            let first_cell = cells.len() as u32;
             let mut aabbs = Vec::with_capacity(object_cells.len());
             for c in &object_cells {
                 let (lo, hi) = f32_box(&c.bounds);
@@ -125,18 +129,16 @@ impl GpuScene {
                     hi,
                     first: lists.len() as u32,
                     count: c.perturbations.len() as u32,
-                    object: index as u32,
-                    pad: 0,
                 });
                 lists.extend(c.perturbations.iter().map(|&i| first_perturbation + i));
             }
             blases.push(AccelerationStructure::bottom_level_aabbs(device, cmds, &aabbs)?);
-            placements.push((blases.len() - 1, object.transform, first_cell));
+            placements.push((blases.len() - 1, object.transform, index as u32));
         }
 
         let instances: Vec<AsInstance<'_>> = placements
             .iter()
-            .map(|&(b, t, first_cell)| AsInstance { blas: &blases[b], transform: row_major_3x4(&t), custom_index: first_cell })
+            .map(|&(b, t, index)| AsInstance { blas: &blases[b], transform: row_major_3x4(&t), custom_index: index })
             .collect();
         let tlas = AccelerationStructure::top_level(device, cmds, &instances)?;
 

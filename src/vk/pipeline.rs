@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{AccelerationStructure, Buffer, Device, VkError};
+use super::{AccelerationStructure, Buffer, Device, Image, VkError};
 
 /// What a descriptor binding holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -13,6 +13,8 @@ pub enum BindingKind {
     AccelerationStructure,
     /// A storage buffer.
     StorageBuffer,
+    /// A storage image (GENERAL layout).
+    StorageImage,
 }
 
 impl BindingKind {
@@ -20,6 +22,7 @@ impl BindingKind {
         match self {
             Self::AccelerationStructure => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
             Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            Self::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
         }
     }
 }
@@ -30,6 +33,8 @@ pub enum Binding<'a> {
     AccelerationStructure(&'a AccelerationStructure),
     /// A whole storage buffer.
     Buffer(&'a Buffer),
+    /// A storage image in GENERAL layout.
+    Image(&'a Image),
 }
 
 /// A compute pipeline, its layout, and one descriptor set.
@@ -135,12 +140,15 @@ impl ComputePipeline {
     pub fn bind(&self, resources: &[Binding<'_>]) {
         assert_eq!(resources.len(), self.bindings.len(), "one resource per binding");
         let mut buffer_infos = Vec::new();
+        let mut image_infos = Vec::new();
         let mut as_handles = Vec::new();
         for r in resources {
             match r {
                 Binding::Buffer(b) => {
                     buffer_infos.push([vk::DescriptorBufferInfo::default().buffer(b.raw).range(vk::WHOLE_SIZE)])
                 }
+                Binding::Image(i) => image_infos
+                    .push([vk::DescriptorImageInfo::default().image_view(i.view).image_layout(vk::ImageLayout::GENERAL)]),
                 Binding::AccelerationStructure(a) => as_handles.push([a.raw]),
             }
         }
@@ -149,7 +157,7 @@ impl ComputePipeline {
             .map(|h| vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(h))
             .collect();
         let mut writes = Vec::new();
-        let (mut bi, mut ai) = (0, 0);
+        let (mut bi, mut ii, mut ai) = (0, 0, 0);
         let mut as_iter = as_infos.iter_mut();
         for (i, r) in resources.iter().enumerate() {
             let base = vk::WriteDescriptorSet::default().dst_set(self.set).dst_binding(i as u32);
@@ -157,6 +165,10 @@ impl ComputePipeline {
                 (Binding::Buffer(_), BindingKind::StorageBuffer) => {
                     writes.push(base.descriptor_type(vk::DescriptorType::STORAGE_BUFFER).buffer_info(&buffer_infos[bi]));
                     bi += 1;
+                }
+                (Binding::Image(_), BindingKind::StorageImage) => {
+                    writes.push(base.descriptor_type(vk::DescriptorType::STORAGE_IMAGE).image_info(&image_infos[ii]));
+                    ii += 1;
                 }
                 (Binding::AccelerationStructure(_), BindingKind::AccelerationStructure) => {
                     // The count must be explicit: it is not implied by a pNext chain
