@@ -35,7 +35,12 @@ fn sphere_scene(n: usize) -> Scene {
         camera: Camera { position: DVec3::new(0.0, 0.0, 4.0), look_at: DVec3::ZERO, up: DVec3::Y, vfov_degrees: 40.0 },
         background: Vec3::ZERO,
         materials: vec![Material { name: "grey".into(), albedo: Vec3::splat(0.8), emission: Vec3::ZERO }],
-        objects: vec![SceneObject { name: format!("sphere with {n} bumps"), shape, transform: DAffine3::IDENTITY, material: 0 }],
+        objects: vec![SceneObject {
+            name: format!("sphere with {n} bumps"),
+            shape,
+            transform: DAffine3::IDENTITY,
+            material: 0,
+        }],
         lights: vec![],
     }
 }
@@ -108,7 +113,8 @@ fn main() {
         if n == 0 {
             base_table = stats.table_bytes;
         }
-        let per_pert = if n > 0 { format!("{:.1}", (stats.table_bytes - base_table) as f64 / n as f64) } else { "-".into() };
+        let per_pert =
+            if n > 0 { format!("{:.1}", (stats.table_bytes - base_table) as f64 / n as f64) } else { "-".into() };
         println!(
             "{:>13} {:>6} {:>6.1} {:>9.2} {:>9.2} {:>7.2} {:>10.2} {:>10.2} {:>12} {:>12}",
             n,

@@ -2,18 +2,21 @@
 # Installs what a fresh Debian 12 (bookworm) or Ubuntu machine lacks to build,
 # run and test the renderer without a GPU:
 #   - the Vulkan loader and the Khronos validation layer,
-#   - Mesa's lavapipe software driver with VK_KHR_ray_query (Mesa >= 23;
+#   - Mesa's lavapipe software driver with VK_KHR_ray_query (Mesa >= 24.1;
 #     on Debian 12 it comes from bookworm-backports),
-#   - Debian's shaderc / glslang / SPIRV-Tools libraries, linked statically by
-#     build.rs so that shaderc is not compiled from source.
+#   - Debian's shaderc / glslang / SPIRV-Tools libraries, linked statically
+#     (see .cargo/config.toml) so that shaderc is not compiled from source,
+#   - a C/C++ toolchain for linking (gcc, g++, libc6-dev) and make.
 # Idempotent: it installs only what is missing and does nothing when all is there.
+# Prints one line per step; apt's output goes to a log file that is shown
+# (its tail) only when a step fails. QUADRAY_SETUP_LOG overrides its path.
 set -euo pipefail
 
 SUDO=""
 if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
 
 need_pkgs=(libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools
-           pkg-config mesa-vulkan-drivers)
+           pkg-config gcc g++ libc6-dev make ca-certificates mesa-vulkan-drivers)
 
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 
@@ -31,6 +34,24 @@ if [[ ${#missing[@]} -eq 0 ]] && mesa_has_ray_query; then
   exit 0
 fi
 
+log=${QUADRAY_SETUP_LOG:-${TMPDIR:-/tmp}/quadray-setup.log}
+: >"$log"
+
+# Runs a step with its output appended to the log; on failure shows the
+# log's tail and stops.
+step() {
+  local what=$1
+  shift
+  echo "setup: $what"
+  if ! "$@" >>"$log" 2>&1; then
+    echo "setup: FAILED: $what (command: $*); last lines of $log:" >&2
+    tail -n 40 "$log" >&2
+    exit 1
+  fi
+}
+
+apt_get() { $SUDO env DEBIAN_FRONTEND=noninteractive apt-get -y -q "$@"; }
+
 codename=""
 if [[ -r /etc/os-release ]]; then . /etc/os-release; codename=${VERSION_CODENAME:-}; fi
 
@@ -39,19 +60,21 @@ if [[ $codename == bookworm ]] && ! grep -rqs "bookworm-backports" /etc/apt/sour
   mirror=$(grep -rhoE 'https?://[^ ]+/debian/?( |$)' /etc/apt/sources.list /etc/apt/sources.list.d/ 2>/dev/null \
              | grep -v security | head -n1 | tr -d " " || true)
   mirror=${mirror:-http://deb.debian.org/debian}
-  echo "setup: adding bookworm-backports from $mirror"
-  printf 'Types: deb\nURIs: %s\nSuites: bookworm-backports\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' \
-    "$mirror" | $SUDO tee /etc/apt/sources.list.d/bookworm-backports.sources >/dev/null
+  step "adding bookworm-backports from $mirror" \
+    $SUDO tee /etc/apt/sources.list.d/bookworm-backports.sources \
+    < <(printf 'Types: deb\nURIs: %s\nSuites: bookworm-backports\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' "$mirror")
 fi
 
-echo "setup: installing ${missing[*]:-mesa-vulkan-drivers (newer)}"
-$SUDO apt-get update -qq
-export DEBIAN_FRONTEND=noninteractive
+echo "setup: missing: ${missing[*]:-none, but mesa-vulkan-drivers is older than 24.1} (apt log: $log)"
+step "apt-get update" apt_get update
 if [[ $codename == bookworm ]]; then
-  $SUDO apt-get install -y -qq -t bookworm-backports mesa-vulkan-drivers
+  step "installing mesa-vulkan-drivers from bookworm-backports" \
+    apt_get install -t bookworm-backports mesa-vulkan-drivers
 else
-  $SUDO apt-get install -y -qq mesa-vulkan-drivers
+  step "installing mesa-vulkan-drivers" apt_get install mesa-vulkan-drivers
 fi
-$SUDO apt-get install -y -qq "${need_pkgs[@]/mesa-vulkan-drivers/}"
+others=()
+for p in "${need_pkgs[@]}"; do [[ $p == mesa-vulkan-drivers ]] || others+=("$p"); done
+step "installing ${others[*]}" apt_get install "${others[@]}"
 mesa_has_ray_query || { echo "setup: mesa-vulkan-drivers is older than 24.1: lavapipe has no ray queries" >&2; exit 1; }
 echo "setup: done"

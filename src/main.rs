@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use quadray::output::{write_exr, write_png, ExrPrecision};
+use quadray::output::{write_outputs, ExrPrecision, OutputKind};
 use quadray::scene::{load_scene, parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
 /// A Vulkan path tracer for functionally defined objects (perturbed quadrics).
@@ -133,6 +133,13 @@ fn load(args: &RenderArgs) -> Result<Scene> {
 
 fn render(args: RenderArgs) -> Result<()> {
     let scene = load(&args)?;
+    if args.output.is_dir() || args.output.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
+        bail!(
+            "-o {}: give a file name (e.g. {}/render), not a directory",
+            args.output.display(),
+            args.output.display()
+        );
+    }
     let outputs = output_paths(&args.output);
     for p in &outputs {
         if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -147,12 +154,20 @@ fn render(args: RenderArgs) -> Result<()> {
     let out = quadray::render_scene(&ctx, &scene, &mut |d, t| progress.update(d, t));
     progress.finish();
     let out = out.context("render failed")?;
-    let precision = if args.half { ExrPrecision::Half } else { ExrPrecision::Float };
-    for p in &outputs {
-        let is_png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        let written = if is_png { write_png(&out, scene.image.exposure, p) } else { write_exr(&out, precision, p) };
-        written.with_context(|| format!("cannot write {}", p.display()))?;
+    if counters.errors() > 0 {
+        bail!("the validation layer reported {} error(s); no output written", counters.errors());
     }
+    let precision = if args.half { ExrPrecision::Half } else { ExrPrecision::Float };
+    let files: Vec<(PathBuf, OutputKind)> = outputs
+        .iter()
+        .map(|p| {
+            let is_png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+            let kind =
+                if is_png { OutputKind::Png { exposure: scene.image.exposure } } else { OutputKind::Exr(precision) };
+            (p.clone(), kind)
+        })
+        .collect();
+    write_outputs(&out, &files)?;
     let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
     eprintln!(
         "wrote {} ({}x{}, {} spp, {:.2} s on {})",
@@ -165,7 +180,7 @@ fn render(args: RenderArgs) -> Result<()> {
     );
     drop(ctx);
     if counters.errors() > 0 {
-        bail!("the validation layer reported {} error(s)", counters.errors());
+        bail!("the validation layer reported {} error(s) at shutdown", counters.errors());
     }
     Ok(())
 }

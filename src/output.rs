@@ -22,16 +22,63 @@ pub enum ExrPrecision {
 pub const EXR_CHANNELS: [&str; 10] =
     ["R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G", "albedo.B"];
 
-/// Writes `path` atomically: `write` fills a temporary file beside it, which
-/// is then renamed over `path`; on error the temporary file is removed.
-pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> io::Result<()>) -> io::Result<()> {
-    let name = path.file_name().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "no file name"))?;
-    let tmp: PathBuf = path.with_file_name(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
-    let result = write(&tmp).and_then(|_| std::fs::rename(&tmp, path));
+/// What to write to one output file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OutputKind {
+    /// Tone-mapped 8-bit sRGB PNG with this exposure (stops).
+    Png {
+        /// Exposure in stops.
+        exposure: f32,
+    },
+    /// Linear EXR with AOVs.
+    Exr(ExrPrecision),
+}
+
+fn temporary_path(path: &Path) -> io::Result<PathBuf> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, format!("{} has no file name", path.display())))?;
+    Ok(path.with_file_name(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id())))
+}
+
+/// Writes several files all or nothing: `write(i, tmp)` fills a temporary
+/// file beside `paths[i]`, and only when all are written are they renamed
+/// into place. On error every temporary file is removed, and the error names
+/// the file that failed.
+pub fn write_all_or_nothing(paths: &[PathBuf], write: impl Fn(usize, &Path) -> io::Result<()>) -> io::Result<()> {
+    let named = |path: &Path, e: io::Error| io::Error::new(e.kind(), format!("cannot write {}: {e}", path.display()));
+    let mut temporaries = Vec::new();
+    let result = (|| {
+        for (i, path) in paths.iter().enumerate() {
+            let tmp = temporary_path(path)?;
+            temporaries.push(tmp.clone());
+            write(i, &tmp).map_err(|e| named(path, e))?;
+        }
+        // A destination that cannot be replaced fails the whole set before any
+        // file is renamed into place.
+        if let Some(dir) = paths.iter().find(|p| p.is_dir()) {
+            return Err(named(dir, io::Error::new(io::ErrorKind::IsADirectory, "a directory is in the way")));
+        }
+        for (path, tmp) in paths.iter().zip(&temporaries) {
+            std::fs::rename(tmp, path).map_err(|e| named(path, e))?;
+        }
+        Ok(())
+    })();
     if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+        for tmp in &temporaries {
+            let _ = std::fs::remove_file(tmp);
+        }
     }
     result
+}
+
+/// Writes the render to every file of `files`, all or nothing.
+pub fn write_outputs(out: &RenderOutput, files: &[(PathBuf, OutputKind)]) -> io::Result<()> {
+    let paths: Vec<PathBuf> = files.iter().map(|(p, _)| p.clone()).collect();
+    write_all_or_nothing(&paths, |i, tmp| match files[i].1 {
+        OutputKind::Png { exposure } => write_png_to(out, exposure, tmp),
+        OutputKind::Exr(precision) => write_exr_to(out, precision, tmp),
+    })
 }
 
 /// sRGB transfer function of a linear value in [0, 1].
@@ -52,26 +99,33 @@ pub fn tone_map(out: &RenderOutput, exposure: f32) -> Vec<u8> {
         .collect()
 }
 
-/// Writes the tone-mapped PNG.
+/// Writes the tone-mapped PNG atomically.
 pub fn write_png(out: &RenderOutput, exposure: f32, path: &Path) -> io::Result<()> {
-    let pixels = tone_map(out, exposure);
-    write_atomically(path, |tmp| {
-        image::save_buffer_with_format(
-            tmp,
-            &pixels,
-            out.width,
-            out.height,
-            image::ColorType::Rgb8,
-            image::ImageFormat::Png,
-        )
-        .map_err(io::Error::other)
-    })
+    write_outputs(out, &[(path.to_path_buf(), OutputKind::Png { exposure })])
 }
 
-/// Writes the linear EXR: RGB radiance and the AOVs `depth` (distance along
-/// the normalised pixel-centre ray, +inf on a miss), `normal.XYZ` (world
-/// space, zero on a miss) and `albedo.RGB`.
+/// Writes the linear EXR atomically (see [`write_exr_to`] for its channels).
 pub fn write_exr(out: &RenderOutput, precision: ExrPrecision, path: &Path) -> io::Result<()> {
+    write_outputs(out, &[(path.to_path_buf(), OutputKind::Exr(precision))])
+}
+
+fn write_png_to(out: &RenderOutput, exposure: f32, path: &Path) -> io::Result<()> {
+    let pixels = tone_map(out, exposure);
+    image::save_buffer_with_format(
+        path,
+        &pixels,
+        out.width,
+        out.height,
+        image::ColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .map_err(io::Error::other)
+}
+
+/// Writes the linear EXR (not atomically): RGB radiance and the AOVs `depth`
+/// (distance along the normalised pixel-centre ray, +inf on a miss),
+/// `normal.XYZ` (world space, zero on a miss) and `albedo.RGB`.
+pub fn write_exr_to(out: &RenderOutput, precision: ExrPrecision, path: &Path) -> io::Result<()> {
     let columns: [Vec<f32>; 10] = [
         out.radiance.iter().map(|p| p[0]).collect(),
         out.radiance.iter().map(|p| p[1]).collect(),
@@ -96,5 +150,5 @@ pub fn write_exr(out: &RenderOutput, precision: ExrPrecision, path: &Path) -> io
         })
         .collect();
     let image = Image::from_channels((out.width as usize, out.height as usize), AnyChannels::sort(channels));
-    write_atomically(path, |tmp| image.write().to_file(tmp).map_err(io::Error::other))
+    image.write().to_file(path).map_err(io::Error::other)
 }

@@ -104,18 +104,28 @@ struct Stats {
     first_failures: Vec<String>,
 }
 
-fn compare(scene: &[Placed], rays: &[GpuRay], gpu: &[GpuHit], refs: &[Option<RefHit>], stats: &mut Stats, check_clip_of_gpu: impl Fn(usize, DVec3) -> f64) {
+fn compare(
+    scene: &[Placed],
+    rays: &[GpuRay],
+    gpu: &[GpuHit],
+    refs: &[Option<RefHit>],
+    stats: &mut Stats,
+    check_clip_of_gpu: impl Fn(usize, DVec3) -> f64,
+) {
     let sil_cos = SILHOUETTE_DEGREES.to_radians().sin();
     for ((ray, g), r) in rays.iter().zip(gpu).zip(refs) {
         stats.rays += 1;
         let o = DVec3::from_array(ray.origin.map(|v| v as f64));
         let d = DVec3::from_array(ray.dir.map(|v| v as f64));
         let gpu_hit = g.object != NO_HIT;
-        let near_edge_gpu = gpu_hit && (gpu_cos(g, d) < sil_cos || check_clip_of_gpu(g.object as usize, o + g.t as f64 * d) < CLIP_EDGE);
+        let near_edge_gpu = gpu_hit
+            && (gpu_cos(g, d) < sil_cos || check_clip_of_gpu(g.object as usize, o + g.t as f64 * d) < CLIP_EDGE);
         let near_edge_ref = r.is_some_and(|r| r.cos < sil_cos || r.clip_edge < CLIP_EDGE);
         match (r, gpu_hit) {
             (None, false) => stats.agree += 1,
-            (Some(r), true) if r.object == g.object as usize && (g.t as f64 - r.t).abs() < 1e-2 * scene[r.object].size => {
+            (Some(r), true)
+                if r.object == g.object as usize && (g.t as f64 - r.t).abs() < 1e-2 * scene[r.object].size =>
+            {
                 stats.hits += 1;
                 if near_edge_gpu || near_edge_ref {
                     stats.excused += 1;
@@ -136,7 +146,13 @@ fn compare(scene: &[Placed], rays: &[GpuRay], gpu: &[GpuHit], refs: &[Option<Ref
                     if stats.first_failures.len() < 5 {
                         stats.first_failures.push(format!(
                             "ray o={:?} d={:?} tmin={}: reference {:?}, gpu t={} object={} (of {})",
-                            ray.origin, ray.dir, ray.tmin, r, g.t, g.object as i64, scene.len()
+                            ray.origin,
+                            ray.dir,
+                            ray.tmin,
+                            r,
+                            g.t,
+                            g.object as i64,
+                            scene.len()
                         ));
                     }
                 }
@@ -160,7 +176,12 @@ fn gpu_ray(o: DVec3, d: DVec3, tmin: f64) -> GpuRay {
 }
 
 /// Rays from `origin_of` toward random points in random objects' boxes.
-fn aimed_rays(rng: &mut Pcg64, boxes: &[Aabb], n: usize, mut origin_of: impl FnMut(&mut Pcg64) -> DVec3) -> Vec<GpuRay> {
+fn aimed_rays(
+    rng: &mut Pcg64,
+    boxes: &[Aabb],
+    n: usize,
+    mut origin_of: impl FnMut(&mut Pcg64) -> DVec3,
+) -> Vec<GpuRay> {
     (0..n)
         .map(|_| {
             let b = boxes[rng.gen_range(0..boxes.len())];
@@ -227,7 +248,13 @@ fn gpu_hits_match_the_f64_reference() {
     for o in &objects {
         let cells = o.shape.cells(&CellParams::default()).unwrap();
         let refs: usize = cells.iter().map(|c| c.perturbations.len()).sum();
-        println!("  {:<13} {:>4} perturbations, {:>6} cells, {:>6} list entries", o.name, o.shape.perturbations.len(), cells.len(), refs);
+        println!(
+            "  {:<13} {:>4} perturbations, {:>6} cells, {:>6} list entries",
+            o.name,
+            o.shape.perturbations.len(),
+            cells.len(),
+            refs
+        );
     }
 
     let clip_distance = |object: usize, world: DVec3| {
@@ -236,7 +263,10 @@ fn gpu_hits_match_the_f64_reference() {
     };
 
     let mut all_ok = true;
-    println!("{:<11} {:>7} {:>7} {:>8} {:>8} {:>9} {:>12} {:>12}", "category", "rays", "hits", "agree", "excused", "failures", "max depth", "max normal°");
+    println!(
+        "{:<11} {:>7} {:>7} {:>8} {:>8} {:>9} {:>12} {:>12}",
+        "category", "rays", "hits", "agree", "excused", "failures", "max depth", "max normal°"
+    );
     for (name, rays, depth_bound, normal_bound) in [
         ("random", &random, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES),
         ("far", &far, FAR_MAX_DEPTH_ERROR, FAR_MAX_NORMAL_DEGREES),

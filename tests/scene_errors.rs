@@ -4,9 +4,7 @@
 
 use std::path::Path;
 
-use quadray::scene::{
-    load_scene, parse_scene, Scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME,
-};
+use quadray::scene::{load_scene, parse_scene, Scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
 /// A valid camera, three lines long.
 const CAMERA: &str = "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n";
@@ -29,10 +27,7 @@ fn check(name: &str, text: &str, line: usize, needles: &[&str]) -> String {
     };
     let first = message.lines().next().unwrap();
     let location = format!("{name}:{line}:");
-    assert!(
-        first.contains(&location),
-        "{name}: expected `{location}` in\n{message}"
-    );
+    assert!(first.contains(&location), "{name}: expected `{location}` in\n{message}");
     for n in needles {
         assert!(message.contains(n), "{name}: expected `{n}` in\n{message}");
     }
@@ -41,12 +36,7 @@ fn check(name: &str, text: &str, line: usize, needles: &[&str]) -> String {
 
 #[test]
 fn unknown_keys() {
-    check(
-        "typo.toml",
-        &format!("{CAMERA}[image]\nwidht = 5\n"),
-        5,
-        &["image.widht", "unknown field `widht`"],
-    );
+    check("typo.toml", &format!("{CAMERA}[image]\nwidht = 5\n"), 5, &["image.widht", "unknown field `widht`"]);
     check(
         "typo_shape.toml",
         &format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1, colour = 2 }}\n"),
@@ -55,7 +45,9 @@ fn unknown_keys() {
     );
     check(
         "typo_object.toml",
-        &format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n\n[[objects]]\nsphere = {{ radius = 1 }}\ncolor = 1\n"),
+        &format!(
+            "{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n\n[[objects]]\nsphere = {{ radius = 1 }}\ncolor = 1\n"
+        ),
         9,
         &["objects[1].color", "unknown field `color`"],
     );
@@ -65,12 +57,7 @@ fn unknown_keys() {
         8,
         &["objects[0].perturbations[0].form", "unknown field `form`"],
     );
-    check(
-        "typo_top.toml",
-        &format!("backgruond = [0, 0, 0]\n{CAMERA}"),
-        1,
-        &["backgruond", "unknown field"],
-    );
+    check("typo_top.toml", &format!("backgruond = [0, 0, 0]\n{CAMERA}"), 1, &["backgruond", "unknown field"]);
     // A top-level key after a table lands in that table; the message says so.
     check(
         "late_background.toml",
@@ -86,21 +73,14 @@ fn nan_and_infinity() {
         "nan.toml",
         &format!("{CAMERA}[[objects]]\nsphere = {{ radius = nan }}\n"),
         5,
-        &[
-            "objects[0].sphere.radius",
-            "must be a finite number (got NaN)",
-        ],
+        &["objects[0].sphere.radius", "must be a finite number (got NaN)"],
     );
     assert!(m.contains("nan.toml:5:21:"), "column of the value: {m}");
     check(
         "inf.toml",
         &format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\ntranslate = [1, -inf, 0]\n"),
         6,
-        &[
-            "objects[0].translate[1]",
-            "must be a finite number (got -inf)",
-            ":6:17:",
-        ],
+        &["objects[0].translate[1]", "must be a finite number (got -inf)", ":6:17:"],
     );
     check(
         "inf_camera.toml",
@@ -120,12 +100,7 @@ fn nan_and_infinity() {
         5,
         &["objects[0].quadric[8]", "finite"],
     );
-    check(
-        "nan_background.toml",
-        &format!("background = [0, inf, 0]\n{CAMERA}"),
-        1,
-        &["background[1]", "finite"],
-    );
+    check("nan_background.toml", &format!("background = [0, inf, 0]\n{CAMERA}"), 1, &["background[1]", "finite"]);
 }
 
 #[test]
@@ -162,7 +137,9 @@ fn negative_radii() {
     );
     check(
         "scatter_radius.toml",
-        &format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects.scatter]]\ncount = 10\nradius = -0.1\nf = 1\n"),
+        &format!(
+            "{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects.scatter]]\ncount = 10\nradius = -0.1\nf = 1\n"
+        ),
         8,
         &["objects[0].scatter[0].radius", "must be positive"],
     );
@@ -176,36 +153,19 @@ fn negative_radii() {
 
 #[test]
 fn image_settings() {
-    for (key, value, shown) in [
-        ("width", "0", "0"),
-        ("height", "-5", "-5"),
-        ("spp", "0", "0"),
-        ("width", "20000", "20000"),
-    ] {
+    for (key, value, shown) in
+        [("width", "0", "0"), ("height", "-5", "-5"), ("spp", "0", "0"), ("width", "20000", "20000")]
+    {
         let name = format!("image_{key}_{}.toml", value.trim_start_matches('-'));
         check(
             &name,
             &format!("[image]\n{key} = {value}\n{CAMERA}"),
             2,
-            &[
-                &format!("image.{key}"),
-                &format!("(got {shown})"),
-                "must be an integer from 1 to",
-            ],
+            &[&format!("image.{key}"), &format!("(got {shown})"), "must be an integer from 1 to"],
         );
     }
-    check(
-        "spp_float.toml",
-        &format!("[image]\nspp = 2.5\n{CAMERA}"),
-        2,
-        &["image.spp", "expected an integer"],
-    );
-    check(
-        "seed.toml",
-        &format!("[image]\nseed = -1\n{CAMERA}"),
-        2,
-        &["image.seed", "from 0 to 4294967295"],
-    );
+    check("spp_float.toml", &format!("[image]\nspp = 2.5\n{CAMERA}"), 2, &["image.spp", "expected an integer"]);
+    check("seed.toml", &format!("[image]\nseed = -1\n{CAMERA}"), 2, &["image.seed", "from 0 to 4294967295"]);
 }
 
 #[test]
@@ -232,10 +192,7 @@ fn degenerate_quadrics() {
         "short_quadric.toml",
         &format!("{CAMERA}[[objects]]\nquadric = [1, 2, 3]\n"),
         5,
-        &[
-            "objects[0].quadric",
-            "must be an array of 10 numbers (got 3)",
-        ],
+        &["objects[0].quadric", "must be an array of 10 numbers (got 3)"],
     );
     check(
         "empty_quadric.toml",
@@ -253,21 +210,11 @@ fn unbounded_surfaces_need_a_clip_box() {
         ("cone", "cone = { half_angle = 30 }"),
         ("paraboloid", "paraboloid = { curvature = 1 }"),
         ("hyperboloid", "hyperboloid = { radius = 0.5, slope = 1 }"),
-        (
-            "hyperboloid",
-            "hyperboloid = { radius = 0.5, slope = 1, sheets = 2 }",
-        ),
+        ("hyperboloid", "hyperboloid = { radius = 0.5, slope = 1, sheets = 2 }"),
         ("quadric", "quadric = [1, 1, -1, 0, 0, 0, 0, 0, 0, -1]"),
     ] {
-        let text = format!(
-            "{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects]]\nname = \"x\"\n{shape}\n"
-        );
-        check(
-            &format!("unbounded_{key}.toml"),
-            &text,
-            8,
-            &[&format!("objects[1].{key}"), "unbounded", "clip"],
-        );
+        let text = format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects]]\nname = \"x\"\n{shape}\n");
+        check(&format!("unbounded_{key}.toml"), &text, 8, &[&format!("objects[1].{key}"), "unbounded", "clip"]);
         // With a clip box it loads.
         let clipped = format!("{text}clip = {{ min = [-1, -1, -1], max = [1, 1, 1] }}\n");
         load(&format!("clipped_{key}.toml"), &clipped).unwrap_or_else(|e| panic!("{e}"));
@@ -284,15 +231,9 @@ fn unbounded_surfaces_need_a_clip_box() {
 fn clip_boxes() {
     check(
         "clip_inverted.toml",
-        &format!(
-            "{CAMERA}[[objects]]\nplane = {{}}\nclip = {{ min = [-1, 1, -1], max = [1, -1, 1] }}\n"
-        ),
+        &format!("{CAMERA}[[objects]]\nplane = {{}}\nclip = {{ min = [-1, 1, -1], max = [1, -1, 1] }}\n"),
         6,
-        &[
-            "objects[0].clip",
-            "min must be less than clip.max",
-            "y: min 1 >= max -1",
-        ],
+        &["objects[0].clip", "min must be less than clip.max", "y: min 1 >= max -1"],
     );
     check(
         "clip_outside.toml",
@@ -312,7 +253,9 @@ fn clip_boxes() {
 fn materials() {
     let m = check(
         "unknown_material.toml",
-        &format!("{CAMERA}[[materials]]\nname = \"clay\"\n[[objects]]\nsphere = {{ radius = 1 }}\nmaterial = \"gold\"\n"),
+        &format!(
+            "{CAMERA}[[materials]]\nname = \"clay\"\n[[objects]]\nsphere = {{ radius = 1 }}\nmaterial = \"gold\"\n"
+        ),
         8,
         &["objects[0].material", "unknown material \"gold\"", "\"clay\""],
     );
@@ -321,11 +264,7 @@ fn materials() {
         "duplicate_material.toml",
         &format!("{CAMERA}[[materials]]\nname = \"a\"\n\n[[materials]]\nname = \"a\"\n"),
         8,
-        &[
-            "materials[1].name",
-            "duplicate material name \"a\"",
-            "line 4",
-        ],
+        &["materials[1].name", "duplicate material name \"a\"", "line 4"],
     );
     check(
         "albedo.toml",
@@ -383,21 +322,13 @@ fn shape_keys() {
         "sphere_number.toml",
         &format!("{CAMERA}[[objects]]\nsphere = 1\n"),
         5,
-        &[
-            "objects[0].sphere",
-            "expected a table such as { radius = 1 }",
-        ],
+        &["objects[0].sphere", "expected a table such as { radius = 1 }"],
     );
     check(
         "perturbation_kind.toml",
-        &format!(
-            "{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects.perturbations]]\nf = 1\n"
-        ),
+        &format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects.perturbations]]\nf = 1\n"),
         6,
-        &[
-            "objects[0].perturbations[0]",
-            "exactly one of `bump` and `quadric`",
-        ],
+        &["objects[0].perturbations[0]", "exactly one of `bump` and `quadric`"],
     );
     check(
         "scatter_on_radii.toml",
@@ -407,7 +338,9 @@ fn shape_keys() {
     );
     check(
         "scatter_count.toml",
-        &format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects.scatter]]\ncount = 0\nradius = 0.1\nf = 1\n"),
+        &format!(
+            "{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[[objects.scatter]]\ncount = 0\nradius = 0.1\nf = 1\n"
+        ),
         7,
         &["objects[0].scatter[0].count", "(got 0)"],
     );
@@ -448,18 +381,8 @@ fn camera() {
             &["camera.fov", "between 0 and 180", &format!("(got {fov})")],
         );
     }
-    check(
-        "no_camera.toml",
-        "[image]\nwidth = 10\n",
-        1,
-        &["camera", "missing"],
-    );
-    check(
-        "no_look_at.toml",
-        "[camera]\nposition = [0, 0, 5]\n",
-        1,
-        &["camera.look_at", "missing"],
-    );
+    check("no_camera.toml", "[image]\nwidth = 10\n", 1, &["camera", "missing"]);
+    check("no_look_at.toml", "[camera]\nposition = [0, 0, 5]\n", 1, &["camera.look_at", "missing"]);
     check(
         "short_vector.toml",
         "[camera]\nposition = [0, 5]\nlook_at = [0, 0, 0]\n",
@@ -496,9 +419,7 @@ fn lights() {
     );
     check(
         "light_negative.toml",
-        &format!(
-            "{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = [1, -1, 1]\n"
-        ),
+        &format!("{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = [1, -1, 1]\n"),
         7,
         &["lights[0].intensity[1]", "must not be negative"],
     );
@@ -512,24 +433,9 @@ fn toml_syntax_errors() {
         5,
         &["invalid TOML", "inline table"],
     );
-    check(
-        "syntax_key.toml",
-        &format!("{CAMERA}[image\nwidth = 3\n"),
-        4,
-        &["invalid TOML"],
-    );
-    check(
-        "duplicate_key.toml",
-        &format!("{CAMERA}fov = 30\nfov = 40\n"),
-        5,
-        &["invalid TOML", "duplicate key"],
-    );
-    check(
-        "wrong_type.toml",
-        &format!("{CAMERA}fov = \"wide\"\n"),
-        4,
-        &["camera.fov", "invalid type"],
-    );
+    check("syntax_key.toml", &format!("{CAMERA}[image\nwidth = 3\n"), 4, &["invalid TOML"]);
+    check("duplicate_key.toml", &format!("{CAMERA}fov = 30\nfov = 40\n"), 5, &["invalid TOML", "duplicate key"]);
+    check("wrong_type.toml", &format!("{CAMERA}fov = \"wide\"\n"), 4, &["camera.fov", "invalid type"]);
 }
 
 #[test]
@@ -547,18 +453,8 @@ fn missing_file_names_the_path() {
 fn error_fields_are_structured() {
     let e = parse_scene(&format!("{CAMERA}[image]\nspp = 0\n"), "x.toml").unwrap_err();
     match e {
-        SceneError::Invalid {
-            file,
-            line,
-            column,
-            field,
-            message,
-            snippet,
-        } => {
-            assert_eq!(
-                (file.as_str(), line, column, field.as_str()),
-                ("x.toml", 5, 7, "image.spp")
-            );
+        SceneError::Invalid { file, line, column, field, message, snippet } => {
+            assert_eq!((file.as_str(), line, column, field.as_str()), ("x.toml", 5, 7, "image.spp"));
             assert!(message.contains("(got 0)"));
             assert_eq!(snippet, "\n5 | spp = 0\n  |       ^");
         }
@@ -605,9 +501,7 @@ fn every_scene_file_loads() {
 /// scenes/README.md must load.
 #[test]
 fn readme_examples_load() {
-    let readme =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/README.md"))
-            .unwrap();
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/README.md")).unwrap();
     let mut n = 0;
     for block in readme.split("```toml\n").skip(1) {
         let block = block.split("```").next().unwrap();
@@ -623,13 +517,8 @@ fn readme_examples_load() {
 fn single_brackets_for_an_array_of_tables() {
     check(
         "single_brackets.toml",
-        &format!(
-            "{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[objects.perturbations]\nf = 1\n"
-        ),
+        &format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\n[objects.perturbations]\nf = 1\n"),
         6,
-        &[
-            "objects[0].perturbations",
-            "write [[objects.perturbations]]",
-        ],
+        &["objects[0].perturbations", "write [[objects.perturbations]]"],
     );
 }

@@ -246,11 +246,7 @@ mod tests {
     use super::*;
 
     fn sphere() -> FunctionalObject {
-        FunctionalObject {
-            base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE),
-            perturbations: vec![],
-            clip: None,
-        }
+        FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None }
     }
 
     #[test]
@@ -303,7 +299,7 @@ mod tests {
             let v = (i as f64 * 0.754878) % 1.0;
             let z = 1.0 - 2.0 * u;
             let r = (1.0 - z * z).sqrt();
-            let dir = DVec3::new(r * (6.283 * v).cos(), z, r * (6.283 * v).sin());
+            let dir = DVec3::new(r * (std::f64::consts::TAU * v).cos(), z, r * (std::f64::consts::TAU * v).sin());
             let (mut a, mut b) = (0.0, 2.0);
             for _ in 0..60 {
                 let m = 0.5 * (a + b);
@@ -314,8 +310,7 @@ mod tests {
                 }
             }
             let p = dir * a;
-            let active: Vec<u32> =
-                (0..200).filter(|&k| o.perturbations[k as usize].quadric.eval(p) > 0.0).collect();
+            let active: Vec<u32> = (0..200).filter(|&k| o.perturbations[k as usize].quadric.eval(p) > 0.0).collect();
             let cell = cells.iter().find(|c| c.bounds.contains(p)).expect("surface point outside every cell");
             for k in active {
                 assert!(cell.perturbations.contains(&k));

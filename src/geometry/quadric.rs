@@ -156,9 +156,7 @@ impl Quadric {
         }
         // Power iteration approaches λ_max from below: bound it by the largest
         // diagonal-dominance (Gershgorin) estimate when that is smaller.
-        let gershgorin = (0..3)
-            .map(|i| (0..3).map(|j| inv.col(j)[i].abs()).sum::<f64>())
-            .fold(0.0f64, f64::max);
+        let gershgorin = (0..3).map(|i| (0..3).map(|j| inv.col(j)[i].abs()).sum::<f64>()).fold(0.0f64, f64::max);
         let lambda = (lambda * (1.0 + 1e-6)).min(gershgorin).max(lambda);
         let radius = (top * lambda).sqrt() * (1.0 + 1e-6) + 1e-12 * centre.length();
         Some((centre, radius))
@@ -166,13 +164,13 @@ impl Quadric {
 
     /// A conservative range of values over `bx`.
     ///
-    /// Centred form around the box's middle m: q(m + h) = q(m) + Σ_i (g_i h_i
-    /// + A_ii h_i²) + Σ_{i<j} 2 A_ij h_i h_j with g = ∇q(m). Each one-axis
-    /// term is bounded exactly on [-e_i, e_i]; the cross terms by
-    /// ±2|A_ij| e_i e_j. The range is exact for quadrics without cross terms
-    /// (ellipsoids, spheres, axis-aligned cylinders, planes), and far
-    /// tighter than interval arithmetic on the expanded form for boxes away
-    /// from the origin.
+    /// Centred form around the box's middle m, with g = ∇q(m) and |h_i| <= e_i:
+    /// q(m + h) = q(m) + Σ_i (g_i h_i + A_ii h_i²) + Σ_{i<j} 2 A_ij h_i h_j.
+    /// Each one-axis term is bounded exactly; each cross term by
+    /// 2 |A_ij| e_i e_j. The range is exact for quadrics without cross terms
+    /// (ellipsoids, spheres, axis-aligned cylinders, planes), and far tighter
+    /// than interval arithmetic on the expanded form for boxes away from the
+    /// origin.
     pub fn range_over(&self, bx: &Aabb) -> (f64, f64) {
         let m = bx.centre();
         let e = 0.5 * bx.size();
@@ -256,7 +254,9 @@ mod tests {
         let (c, r) = q.support_sphere().unwrap();
         assert!((r - 0.8).abs() < 1e-5, "radius {r}");
         assert!((c - m.transform_point3(DVec3::new(0.5, -1.0, 2.0))).length() < 1e-9);
-        assert!(Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0]).support_sphere().is_none());
+        assert!(Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+            .support_sphere()
+            .is_none());
     }
 
     #[test]

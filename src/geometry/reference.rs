@@ -27,10 +27,17 @@ pub fn intersect(obj: &FunctionalObject, o: DVec3, d: DVec3, t_min: f64, t_max: 
 
 /// [`intersect`] with the object's bounds ([`FunctionalObject::bounds`]) given,
 /// for callers that trace many rays.
-pub fn intersect_within(obj: &FunctionalObject, bounds: &Aabb, o: DVec3, d: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
+pub fn intersect_within(
+    obj: &FunctionalObject,
+    bounds: &Aabb,
+    o: DVec3,
+    d: DVec3,
+    t_min: f64,
+    t_max: f64,
+) -> Option<Hit> {
     let (b0, b1) = bounds.ray_range(o, d);
     let (t0, t1) = (t_min.max(b0), t_max.min(b1));
-    if !(t0 <= t1) {
+    if t0.is_nan() || t1.is_nan() || t0 > t1 {
         return None;
     }
     // Only perturbations that are positive somewhere on the segment matter.
@@ -122,7 +129,8 @@ mod tests {
 
     #[test]
     fn unit_sphere_hit_from_outside() {
-        let s = FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None };
+        let s =
+            FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None };
         let h = intersect(&s, DVec3::new(0.0, 0.0, -5.0), DVec3::Z, 0.0, f64::INFINITY).unwrap();
         assert!((h.t - 4.0).abs() < 1e-12);
         assert!((h.normal - DVec3::NEG_Z).length() < 1e-12);
@@ -131,7 +139,8 @@ mod tests {
     /// The reference must agree with brute-force dense sampling of F'.
     #[test]
     fn agrees_with_dense_sampling_on_a_bumpy_sphere() {
-        let mut o = FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None };
+        let mut o =
+            FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None };
         for i in 0..30 {
             let a = i as f64 * 2.4;
             let z = 1.0 - 2.0 * (i as f64 + 0.5) / 30.0;

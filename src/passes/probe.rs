@@ -45,7 +45,15 @@ impl ProbePass {
             MemoryLocation::GpuToCpu,
         )?;
         let [tlas, objects, cells, perturbations, lists] = scene.geometry_bindings();
-        pipeline.bind(&[tlas, objects, cells, perturbations, lists, Binding::Buffer(&rays_buf), Binding::Buffer(&hits)]);
+        pipeline.bind(&[
+            tlas,
+            objects,
+            cells,
+            perturbations,
+            lists,
+            Binding::Buffer(&rays_buf),
+            Binding::Buffer(&hits),
+        ]);
         let timestamps = Timestamps::new(device, 2)?;
         Ok(Self { pipeline, rays: rays_buf, hits, count: rays.len() as u32, timestamps })
     }

@@ -9,7 +9,9 @@ use super::gpu::{GpuAov, GpuFrame, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use crate::scene::Scene;
 use crate::shader_interface::RENDER_GROUP;
-use crate::vk::{full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation};
+use crate::vk::{
+    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation,
+};
 use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
@@ -100,9 +102,7 @@ pub fn render(
 
     let tiles: Vec<[u32; 4]> = (0..height)
         .step_by(TILE as usize)
-        .flat_map(|y| {
-            (0..width).step_by(TILE as usize).map(move |x| [x, y, TILE.min(width - x), TILE.min(height - y)])
-        })
+        .flat_map(|y| (0..width).step_by(TILE as usize).map(move |x| [x, y, TILE.min(width - x), TILE.min(height - y)]))
         .collect();
     let total = tiles.len() as u64 * spp as u64;
     cmds.run(|_, cmd| {
@@ -136,7 +136,8 @@ pub fn render(
 
     cmds.run(|d, cmd| {
         full_barrier(d, cmd);
-        accum.copy_to_buffer(cmd, &readback);
+        accum.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        accum.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, &readback);
         full_barrier(d, cmd);
     })?;
     let sums: Vec<[f32; 4]> = readback.read();

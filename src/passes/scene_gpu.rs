@@ -90,7 +90,12 @@ fn storage(device: &Arc<Device>, name: &str, bytes: &[u8]) -> Result<Buffer, Ren
 
 impl GpuScene {
     /// Splits every object into cells and uploads the scene.
-    pub fn new(device: &Arc<Device>, cmds: &mut Commands, scene: &Scene, params: &CellParams) -> Result<Self, RenderError> {
+    pub fn new(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        scene: &Scene,
+        params: &CellParams,
+    ) -> Result<Self, RenderError> {
         let mut objects = Vec::new();
         let mut cells: Vec<GpuCell> = Vec::new();
         let mut perturbations: Vec<GpuPerturbation> = Vec::new();
@@ -104,13 +109,7 @@ impl GpuScene {
                 .cells(params)
                 .map_err(|source| RenderError::Geometry { object: object.name.clone(), source })?;
             let first_perturbation = perturbations.len() as u32;
-            perturbations.extend(
-                object
-                    .shape
-                    .perturbations
-                    .iter()
-                    .map(GpuPerturbation::from),
-            );
+            perturbations.extend(object.shape.perturbations.iter().map(GpuPerturbation::from));
             let first_cell = cells.len() as u32;
             objects.push(GpuObject {
                 base: GpuQuadric::from(&object.shape.base),
@@ -124,12 +123,7 @@ impl GpuScene {
             for c in &object_cells {
                 let (lo, hi) = f32_box(&c.bounds);
                 aabbs.push([lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]);
-                cells.push(GpuCell {
-                    lo,
-                    hi,
-                    first: lists.len() as u32,
-                    count: c.perturbations.len() as u32,
-                });
+                cells.push(GpuCell { lo, hi, first: lists.len() as u32, count: c.perturbations.len() as u32 });
                 lists.extend(c.perturbations.iter().map(|&i| first_perturbation + i));
             }
             blases.push(AccelerationStructure::bottom_level_aabbs(device, cmds, &aabbs)?);

@@ -49,7 +49,7 @@ pub const DEFAULT_MATERIAL_NAME: &str = "<default>";
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file could not be read.
-    #[error("{}: cannot read the scene file: {source}", .path.display())]
+    #[error("{}: cannot read the scene file", .path.display())]
     Read {
         /// The path that was asked for.
         path: PathBuf,
@@ -75,14 +75,7 @@ pub enum SceneError {
     },
 }
 
-fn render_invalid(
-    file: &str,
-    line: usize,
-    column: usize,
-    field: &str,
-    message: &str,
-    snippet: &str,
-) -> String {
+fn render_invalid(file: &str, line: usize, column: usize, field: &str, message: &str, snippet: &str) -> String {
     let mut s = format!("{file}:{line}:{column}: ");
     if !field.is_empty() {
         s.push_str(field);
@@ -95,21 +88,15 @@ fn render_invalid(
 
 /// Reads and parses the scene file at `path`; messages name the path as given.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;
     parse_scene(&text, &path.display().to_string())
 }
 
 /// Parses a scene from TOML text; `file_name` is used in error messages.
 pub fn parse_scene(source: &str, file_name: &str) -> Result<Scene, SceneError> {
-    let src = Source {
-        text: source,
-        file: file_name,
-    };
-    let raw: RawScene = serde_path_to_error::deserialize(toml::Deserializer::new(source))
-        .map_err(|e| src.toml_error(e))?;
+    let src = Source { text: source, file: file_name };
+    let raw: RawScene =
+        serde_path_to_error::deserialize(toml::Deserializer::new(source)).map_err(|e| src.toml_error(e))?;
     build_scene(&src, raw)
 }
 
@@ -124,12 +111,7 @@ struct Source<'a> {
 
 impl Source<'_> {
     /// An error at `span` (byte range into the text; start of file if none).
-    fn error(
-        &self,
-        span: Option<Range<usize>>,
-        field: impl Into<String>,
-        message: impl Into<String>,
-    ) -> SceneError {
+    fn error(&self, span: Option<Range<usize>>, field: impl Into<String>, message: impl Into<String>) -> SceneError {
         let text = self.text;
         let span = span.unwrap_or(0..0);
         let mut start = span.start.min(text.len());
@@ -149,21 +131,10 @@ impl Source<'_> {
             String::new()
         } else {
             // Keep tabs in the padding so that the caret lines up.
-            let pad: String = text[line_start..start]
-                .chars()
-                .map(|c| if c == '\t' { '\t' } else { ' ' })
-                .collect();
-            let width = text[start..end]
-                .trim_end_matches('\r')
-                .chars()
-                .count()
-                .max(1);
+            let pad: String = text[line_start..start].chars().map(|c| if c == '\t' { '\t' } else { ' ' }).collect();
+            let width = text[start..end].trim_end_matches('\r').chars().count().max(1);
             let gutter = line.to_string().len();
-            format!(
-                "\n{line:>gutter$} | {source_line}\n{:>gutter$} | {pad}{}",
-                "",
-                "^".repeat(width)
-            )
+            format!("\n{line:>gutter$} | {source_line}\n{:>gutter$} | {pad}{}", "", "^".repeat(width))
         };
         SceneError::Invalid {
             file: self.file.to_owned(),
@@ -182,8 +153,7 @@ impl Source<'_> {
                 serde_path_to_error::Segment::Seq { index } => {
                     let _ = write!(field, "[{index}]");
                 }
-                serde_path_to_error::Segment::Map { key }
-                | serde_path_to_error::Segment::Enum { variant: key } => {
+                serde_path_to_error::Segment::Map { key } | serde_path_to_error::Segment::Enum { variant: key } => {
                     // Skip the private keys of `toml::Spanned`.
                     if !key.starts_with("$__") {
                         if !field.is_empty() {
@@ -196,17 +166,8 @@ impl Source<'_> {
             }
         }
         let inner = e.inner();
-        let mut message = inner
-            .message()
-            .trim()
-            .lines()
-            .map(str::trim)
-            .collect::<Vec<_>>()
-            .join(": ");
-        if let Some(missing) = message
-            .strip_prefix("missing field `")
-            .and_then(|m| m.strip_suffix('`'))
-        {
+        let mut message = inner.message().trim().lines().map(str::trim).collect::<Vec<_>>().join(": ");
+        if let Some(missing) = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`')) {
             if !field.is_empty() {
                 field.push('.');
             }
@@ -216,13 +177,8 @@ impl Source<'_> {
             message = format!("invalid TOML: {message}");
         } else if message == "invalid type: map, expected a sequence" {
             // The table header of the array: the path without its indices.
-            let header: String = field
-                .split('[')
-                .map(|p| p.split_once(']').map_or(p, |(_, rest)| rest))
-                .collect();
-            message.push_str(&format!(
-                " (write [[{header}]] with double brackets for each entry)"
-            ));
+            let header: String = field.split('[').map(|p| p.split_once(']').map_or(p, |(_, rest)| rest)).collect();
+            message.push_str(&format!(" (write [[{header}]] with double brackets for each entry)"));
         } else if message.starts_with("unknown field `background`") && field.contains('.') {
             message.push_str(
                 " (top-level keys such as `background` must come before the first [table] header, \
@@ -379,9 +335,7 @@ impl<'de, const LO: i64, const HI: i64> Visitor<'de> for IntVisitor<LO, HI> {
         if (LO..=HI).contains(&v) {
             Ok(Int(v))
         } else {
-            Err(E::custom(format!(
-                "must be an integer from {LO} to {HI} (got {v})"
-            )))
+            Err(E::custom(format!("must be an integer from {LO} to {HI} (got {v})")))
         }
     }
 
@@ -417,9 +371,7 @@ where
         n += 1;
     }
     if n != N {
-        return Err(de::Error::custom(format!(
-            "must be an array of {N} numbers (got {n})"
-        )));
+        return Err(de::Error::custom(format!("must be an array of {N} numbers (got {n})")));
     }
     Ok(out)
 }
@@ -468,9 +420,7 @@ impl<'de> Visitor<'de> for PositiveVecVisitor {
     }
 
     fn visit_f64<E: de::Error>(self, v: f64) -> Result<PositiveVec, E> {
-        Positive::parse(v)
-            .map(|p| PositiveVec(DVec3::splat(p.get())))
-            .map_err(E::custom)
+        Positive::parse(v).map(|p| PositiveVec(DVec3::splat(p.get()))).map_err(E::custom)
     }
 
     fn visit_i64<E: de::Error>(self, v: i64) -> Result<PositiveVec, E> {
@@ -554,10 +504,7 @@ struct RawImage {
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a [camera] table with position and look_at"
-)]
+#[serde(deny_unknown_fields, expecting = "a [camera] table with position and look_at")]
 struct RawCamera {
     position: Triple<Finite>,
     look_at: Spanned<Triple<Finite>>,
@@ -603,10 +550,7 @@ struct RawSphere {
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a table such as { radii = [1, 0.5, 2] }"
-)]
+#[serde(deny_unknown_fields, expecting = "a table such as { radii = [1, 0.5, 2] }")]
 struct RawEllipsoid {
     radii: Triple<Positive>,
 }
@@ -634,10 +578,7 @@ struct RawParaboloid {
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a table such as { radius = 0.5, slope = 1, sheets = 1 }"
-)]
+#[serde(deny_unknown_fields, expecting = "a table such as { radius = 0.5, slope = 1, sheets = 1 }")]
 struct RawHyperboloid {
     radius: Positive,
     slope: Positive,
@@ -645,20 +586,14 @@ struct RawHyperboloid {
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a table such as { min = [-1, -1, -1], max = [1, 1, 1] }"
-)]
+#[serde(deny_unknown_fields, expecting = "a table such as { min = [-1, -1, -1], max = [1, 1, 1] }")]
 struct RawClip {
     min: Triple<Finite>,
     max: Triple<Finite>,
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a perturbation table with `f` and one of `bump` or `quadric`"
-)]
+#[serde(deny_unknown_fields, expecting = "a perturbation table with `f` and one of `bump` or `quadric`")]
 struct RawPerturbation {
     bump: Option<RawBump>,
     quadric: Option<Spanned<Coefficients>>,
@@ -666,10 +601,7 @@ struct RawPerturbation {
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a table such as { centre = [0, 1, 0], radius = 0.2 }"
-)]
+#[serde(deny_unknown_fields, expecting = "a table such as { centre = [0, 1, 0], radius = 0.2 }")]
 struct RawBump {
     #[serde(alias = "center")]
     centre: Triple<Finite>,
@@ -677,10 +609,7 @@ struct RawBump {
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a scatter table with count, radius and f"
-)]
+#[serde(deny_unknown_fields, expecting = "a scatter table with count, radius and f")]
 struct RawScatter {
     count: Count,
     on_radii: Option<Triple<Positive>>,
@@ -701,10 +630,7 @@ enum LightKind {
 }
 
 #[derive(Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a light table with type and position"
-)]
+#[serde(deny_unknown_fields, expecting = "a light table with type and position")]
 struct RawLight {
     #[serde(rename = "type")]
     kind: LightKind,
@@ -725,9 +651,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         height: image.and_then(|i| i.height).map_or(480, |v| v.get() as u32),
         spp: image.and_then(|i| i.spp).map_or(16, |v| v.get() as u32),
         seed: image.and_then(|i| i.seed).map_or(0, |v| v.get() as u32),
-        exposure: image
-            .and_then(|i| i.exposure)
-            .map_or(0.0, |v| v.get() as f32),
+        exposure: image.and_then(|i| i.exposure).map_or(0.0, |v| v.get() as f32),
     };
     let camera = build_camera(src, &raw.camera)?;
     let background = raw.background.map_or(Vec3::ZERO, |b| b.get().as_vec3());
@@ -739,11 +663,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         let m = m.get_ref();
         let name = m.name.get_ref();
         if name.is_empty() {
-            return Err(src.error(
-                Some(m.name.span()),
-                format!("materials[{i}].name"),
-                "must not be empty",
-            ));
+            return Err(src.error(Some(m.name.span()), format!("materials[{i}].name"), "must not be empty"));
         }
         if let Some(first) = materials.iter().position(|o| &o.name == name) {
             let line: usize = material_lines[first];
@@ -753,12 +673,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
                 format!("duplicate material name {name:?} (first defined at line {line} as materials[{first}])"),
             ));
         }
-        material_lines.push(
-            src.text[..span.start.min(src.text.len())]
-                .matches('\n')
-                .count()
-                + 1,
-        );
+        material_lines.push(src.text[..span.start.min(src.text.len())].matches('\n').count() + 1);
         materials.push(Material {
             name: name.clone(),
             albedo: m.albedo.map_or(Vec3::splat(0.8), |a| a.get().as_vec3()),
@@ -770,16 +685,11 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
     let mut objects = Vec::with_capacity(raw.objects.len());
     for (i, o) in raw.objects.iter().enumerate() {
         let material = match &o.get_ref().material {
-            Some(name) => match materials[..user_materials]
-                .iter()
-                .position(|m| &m.name == name.get_ref())
-            {
+            Some(name) => match materials[..user_materials].iter().position(|m| &m.name == name.get_ref()) {
                 Some(k) => k,
                 None => {
-                    let known: Vec<String> = materials[..user_materials]
-                        .iter()
-                        .map(|m| format!("{:?}", m.name))
-                        .collect();
+                    let known: Vec<String> =
+                        materials[..user_materials].iter().map(|m| format!("{:?}", m.name)).collect();
                     let known = if known.is_empty() {
                         "no [[materials]] are defined".to_owned()
                     } else {
@@ -806,21 +716,9 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         objects.push(build_object(src, i, o, material)?);
     }
 
-    let lights = raw
-        .lights
-        .iter()
-        .enumerate()
-        .map(|(i, l)| build_light(src, i, l))
-        .collect::<Result<Vec<_>, _>>()?;
+    let lights = raw.lights.iter().enumerate().map(|(i, l)| build_light(src, i, l)).collect::<Result<Vec<_>, _>>()?;
 
-    Ok(Scene {
-        image,
-        camera,
-        background,
-        materials,
-        objects,
-        lights,
-    })
+    Ok(Scene { image, camera, background, materials, objects, lights })
 }
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {
@@ -852,25 +750,12 @@ fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneE
             format!("must not be parallel to the view direction look_at - position{default_note}"),
         ));
     }
-    Ok(Camera {
-        position,
-        look_at,
-        up,
-        vfov_degrees: c.fov.map_or(40.0, |f| f.get()),
-    })
+    Ok(Camera { position, look_at, up, vfov_degrees: c.fov.map_or(40.0, |f| f.get()) })
 }
 
 /// The shape keys of an object, in the order they are listed in messages.
-const SHAPE_KEYS: [&str; 8] = [
-    "sphere",
-    "ellipsoid",
-    "plane",
-    "cylinder",
-    "cone",
-    "paraboloid",
-    "hyperboloid",
-    "quadric",
-];
+const SHAPE_KEYS: [&str; 8] =
+    ["sphere", "ellipsoid", "plane", "cylinder", "cone", "paraboloid", "hyperboloid", "quadric"];
 
 /// The base quadric of an object's one shape key, with that key and the span
 /// of its value.
@@ -900,10 +785,7 @@ fn base_shape(
             return Err(src.error(
                 Some(raw.span()),
                 format!("objects[{i}]"),
-                format!(
-                    "the object needs exactly one shape key ({}); found none",
-                    SHAPE_KEYS.join(", ")
-                ),
+                format!("the object needs exactly one shape key ({}); found none", SHAPE_KEYS.join(", ")),
             ))
         }
         [_, second, ..] => {
@@ -911,11 +793,7 @@ fn base_shape(
             return Err(src.error(
                 Some(second.1.clone()),
                 format!("objects[{i}].{}", second.0),
-                format!(
-                    "the object needs exactly one shape key; found {}: {}",
-                    keys.len(),
-                    keys.join(", ")
-                ),
+                format!("the object needs exactly one shape key; found {}: {}", keys.len(), keys.join(", ")),
             ));
         }
     };
@@ -939,11 +817,7 @@ fn base_shape(
         let h = h.get_ref();
         let w = 1.0 / h.radius.get().powi(2);
         let s = h.slope.get().powi(2) * w;
-        let k = if h.sheets.map_or(1, Int::get) == 1 {
-            1.0
-        } else {
-            -1.0
-        };
+        let k = if h.sheets.map_or(1, Int::get) == 1 { 1.0 } else { -1.0 };
         q([-w, s, -w, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, k])
     } else if let Some(c) = &o.quadric {
         c.get_ref().0
@@ -953,12 +827,7 @@ fn base_shape(
     Ok((base, key, span))
 }
 
-fn build_object(
-    src: &Source,
-    i: usize,
-    raw: &Spanned<RawObject>,
-    material: usize,
-) -> Result<SceneObject, SceneError> {
+fn build_object(src: &Source, i: usize, raw: &Spanned<RawObject>, material: usize) -> Result<SceneObject, SceneError> {
     let o = raw.get_ref();
     let (base, shape_key, shape_span) = base_shape(src, i, raw)?;
 
@@ -988,11 +857,7 @@ fn build_object(
             (Some(b), None) => Quadric::ellipsoid(b.centre.get(), b.radius.0),
             (None, Some(q)) => q.get_ref().0,
             (b, q) => {
-                let found = if b.is_some() && q.is_some() {
-                    "found both"
-                } else {
-                    "found neither"
-                };
+                let found = if b.is_some() && q.is_some() { "found both" } else { "found neither" };
                 return Err(src.error(
                     Some(p.span()),
                     format!("objects[{i}].perturbations[{j}]"),
@@ -1000,10 +865,7 @@ fn build_object(
                 ));
             }
         };
-        perturbations.push(Perturbation {
-            quadric,
-            form_factor: r.f.get(),
-        });
+        perturbations.push(Perturbation { quadric, form_factor: r.f.get() });
     }
     for (j, s) in o.scatter.iter().enumerate() {
         let r = s.get_ref();
@@ -1031,34 +893,19 @@ fn build_object(
         }));
     }
 
-    let shape = FunctionalObject {
-        base,
-        perturbations,
-        clip,
-    };
+    let shape = FunctionalObject { base, perturbations, clip };
     if let Err(e) = shape.bounds() {
-        return Err(geometry_error(
-            src, i, raw, shape_key, shape_span, &shape, e,
-        ));
+        return Err(geometry_error(src, i, raw, shape_key, shape_span, &shape, e));
     }
 
     let translate = o.translate.map_or(DVec3::ZERO, Triple::get);
     let rotate = o.rotate.map_or(DVec3::ZERO, Triple::get);
     let scale = o.scale.map_or(DVec3::ONE, |s| s.0);
-    let rotation = DQuat::from_euler(
-        EulerRot::XYZ,
-        rotate.x.to_radians(),
-        rotate.y.to_radians(),
-        rotate.z.to_radians(),
-    );
+    let rotation =
+        DQuat::from_euler(EulerRot::XYZ, rotate.x.to_radians(), rotate.y.to_radians(), rotate.z.to_radians());
     let transform = DAffine3::from_scale_rotation_translation(scale, rotation, translate);
 
-    Ok(SceneObject {
-        name: o.name.clone().unwrap_or_else(|| format!("objects[{i}]")),
-        shape,
-        transform,
-        material,
-    })
+    Ok(SceneObject { name: o.name.clone().unwrap_or_else(|| format!("objects[{i}]")), shape, transform, material })
 }
 
 fn geometry_error(
@@ -1086,10 +933,7 @@ fn geometry_error(
                 .iter()
                 .position(|p| {
                     let r = p.get_ref();
-                    r.f.get() > 0.0
-                        && r.quadric
-                            .as_ref()
-                            .is_some_and(|q| q.get_ref().0.support_bounds().is_none())
+                    r.f.get() > 0.0 && r.quadric.as_ref().is_some_and(|q| q.get_ref().0.support_bounds().is_none())
                 })
                 .unwrap_or(0);
             let span = o.perturbations.get(j).map_or(raw.span(), Spanned::span);
@@ -1101,11 +945,9 @@ fn geometry_error(
             )
         }
         GeometryError::Empty(_) => match &o.clip {
-            Some(c) => src.error(
-                Some(c.span()),
-                format!("objects[{i}].clip"),
-                "the surface has no point inside the clip box",
-            ),
+            Some(c) => {
+                src.error(Some(c.span()), format!("objects[{i}].clip"), "the surface has no point inside the clip box")
+            }
             None => src.error(
                 Some(shape_span),
                 format!("objects[{i}].{shape_key}"),
@@ -1120,11 +962,7 @@ fn build_light(src: &Source, i: usize, raw: &Spanned<RawLight>) -> Result<Light,
     let l = raw.get_ref();
     let position = l.position.get();
     let unexpected = |key: &str, span: Range<usize>, kind: &str| {
-        src.error(
-            Some(span),
-            format!("lights[{i}].{key}"),
-            format!("`{key}` does not apply to a {kind} light"),
-        )
+        src.error(Some(span), format!("lights[{i}].{key}"), format!("`{key}` does not apply to a {kind} light"))
     };
     let missing = |key: &str, kind: &str| {
         src.error(
@@ -1141,27 +979,15 @@ fn build_light(src: &Source, i: usize, raw: &Spanned<RawLight>) -> Result<Light,
             if let Some(r) = &l.radiance {
                 return Err(unexpected("radiance", r.span(), "point (use `intensity`)"));
             }
-            let intensity = l
-                .intensity
-                .as_ref()
-                .ok_or_else(|| missing("intensity", "point"))?;
-            Ok(Light::Point {
-                position,
-                intensity: intensity.get_ref().get().as_vec3(),
-            })
+            let intensity = l.intensity.as_ref().ok_or_else(|| missing("intensity", "point"))?;
+            Ok(Light::Point { position, intensity: intensity.get_ref().get().as_vec3() })
         }
         LightKind::Sphere => {
             if let Some(r) = &l.intensity {
                 return Err(unexpected("intensity", r.span(), "sphere (use `radiance`)"));
             }
-            let radius = l
-                .radius
-                .as_ref()
-                .ok_or_else(|| missing("radius", "sphere"))?;
-            let radiance = l
-                .radiance
-                .as_ref()
-                .ok_or_else(|| missing("radiance", "sphere"))?;
+            let radius = l.radius.as_ref().ok_or_else(|| missing("radius", "sphere"))?;
+            let radiance = l.radiance.as_ref().ok_or_else(|| missing("radiance", "sphere"))?;
             Ok(Light::Sphere {
                 centre: position,
                 radius: radius.get_ref().get(),
@@ -1206,15 +1032,8 @@ fn scatter(p: ScatterParams) -> impl Iterator<Item = Perturbation> {
             let b = hash_unit(p.seed, i as u64, 1) - 0.5;
             u = (u + p.jitter * spacing * (a * t1 + b * t2)).normalize();
         }
-        let f = if p.alternate && i % 2 == 1 {
-            -p.form_factor
-        } else {
-            p.form_factor
-        };
-        Perturbation {
-            quadric: Quadric::ellipsoid(p.centre + p.on_radii * u, p.radius),
-            form_factor: f,
-        }
+        let f = if p.alternate && i % 2 == 1 { -p.form_factor } else { p.form_factor };
+        Perturbation { quadric: Quadric::ellipsoid(p.centre + p.on_radii * u, p.radius), form_factor: f }
     })
 }
 
@@ -1242,10 +1061,7 @@ mod tests {
     }
 
     fn one_shape(shape: &str) -> FunctionalObject {
-        parse(&format!(
-            "[[objects]]\n{shape}\nclip = {{ min = [-3, -3, -3], max = [3, 3, 3] }}\n"
-        ))
-        .objects[0]
+        parse(&format!("[[objects]]\n{shape}\nclip = {{ min = [-3, -3, -3], max = [3, 3, 3] }}\n")).objects[0]
             .shape
             .clone()
     }
@@ -1257,16 +1073,7 @@ mod tests {
     #[test]
     fn defaults() {
         let s = parse("");
-        assert_eq!(
-            s.image,
-            ImageSettings {
-                width: 640,
-                height: 480,
-                spp: 16,
-                seed: 0,
-                exposure: 0.0
-            }
-        );
+        assert_eq!(s.image, ImageSettings { width: 640, height: 480, spp: 16, seed: 0, exposure: 0.0 });
         assert_eq!(s.camera.up, DVec3::Y);
         assert_eq!(s.camera.vfov_degrees, 40.0);
         assert_eq!(s.background, Vec3::ZERO);
@@ -1277,16 +1084,7 @@ mod tests {
     fn image_and_background() {
         let text = "background = [0.1, 0.2, 0.3]\n[image]\nwidth = 64\nheight = 48\nspp = 3\nseed = 4000000000\nexposure = -1.5\n";
         let s = parse_scene(&format!("{text}{CAMERA}"), "t.toml").unwrap();
-        assert_eq!(
-            s.image,
-            ImageSettings {
-                width: 64,
-                height: 48,
-                spp: 3,
-                seed: 4_000_000_000,
-                exposure: -1.5
-            }
-        );
+        assert_eq!(s.image, ImageSettings { width: 64, height: 48, spp: 3, seed: 4_000_000_000, exposure: -1.5 });
         assert_eq!(s.background, Vec3::new(0.1, 0.2, 0.3));
     }
 
@@ -1298,11 +1096,7 @@ mod tests {
         assert!(s.eval(DVec3::ZERO) > 0.0);
         assert!(s.eval(DVec3::new(0.0, 2.1, 0.0)) < 0.0);
         let e = one_shape("ellipsoid = { radii = [1, 0.5, 2] }");
-        for p in [
-            DVec3::X,
-            DVec3::new(0.0, 0.5, 0.0),
-            DVec3::new(0.0, 0.0, -2.0),
-        ] {
+        for p in [DVec3::X, DVec3::new(0.0, 0.5, 0.0), DVec3::new(0.0, 0.0, -2.0)] {
             assert!(near(e.eval(p), 0.0));
         }
         assert!(e.eval(DVec3::ZERO) > 0.0);
@@ -1343,10 +1137,7 @@ mod tests {
         // s² y² - (x² + z²) = r²: vertices at y = ±r/s
         assert!(near(h2.eval(DVec3::new(0.0, 0.25, 0.0)), 0.0));
         assert!(near(h2.eval(DVec3::new(0.0, -0.25, 0.0)), 0.0));
-        assert!(near(
-            h2.eval(DVec3::new((4.0f64 - 0.25).sqrt(), 1.0, 0.0)),
-            0.0
-        ));
+        assert!(near(h2.eval(DVec3::new((4.0f64 - 0.25).sqrt(), 1.0, 0.0)), 0.0));
         assert!(h2.eval(DVec3::new(0.0, 1.0, 0.0)) > 0.0);
         assert!(h2.eval(DVec3::ZERO) < 0.0);
     }
@@ -1357,27 +1148,10 @@ mod tests {
             "[[objects]]\nquadric = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\nclip = { min = [-1, -2, -3], max = [1, 2, 3] }\n",
         );
         let o = &s.objects[0].shape;
-        assert_eq!(
-            o.base.coefficients(),
-            [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0]
-        );
-        assert_eq!(
-            o.clip,
-            Some(Aabb::new(
-                DVec3::new(-1.0, -2.0, -3.0),
-                DVec3::new(1.0, 2.0, 3.0)
-            ))
-        );
-        assert_eq!(
-            one_shape("sphere = { radius = 1 }").clip.unwrap().max,
-            DVec3::splat(3.0)
-        );
-        assert_eq!(
-            parse("[[objects]]\nsphere = { radius = 1 }\n").objects[0]
-                .shape
-                .clip,
-            None
-        );
+        assert_eq!(o.base.coefficients(), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0]);
+        assert_eq!(o.clip, Some(Aabb::new(DVec3::new(-1.0, -2.0, -3.0), DVec3::new(1.0, 2.0, 3.0))));
+        assert_eq!(one_shape("sphere = { radius = 1 }").clip.unwrap().max, DVec3::splat(3.0));
+        assert_eq!(parse("[[objects]]\nsphere = { radius = 1 }\n").objects[0].shape.clip, None);
     }
 
     #[test]
@@ -1389,10 +1163,7 @@ mod tests {
              [[objects]]\nsphere = { radius = 1 }\nrotate = [90, 90, 0]\n",
         );
         let t = &s.objects;
-        assert_eq!(
-            t[0].transform,
-            DAffine3::from_translation(DVec3::new(1.0, 2.0, 3.0))
-        );
+        assert_eq!(t[0].transform, DAffine3::from_translation(DVec3::new(1.0, 2.0, 3.0)));
         let p = t[1].transform.transform_point3(DVec3::X);
         assert!((p - DVec3::new(0.0, 2.0, 0.0)).length() < 1e-12, "{p}");
         let p = t[2].transform.transform_point3(DVec3::ONE);
@@ -1415,15 +1186,9 @@ mod tests {
         );
         let p = &s.objects[0].shape.perturbations;
         assert_eq!(p.len(), 3);
-        assert_eq!(
-            p[0].quadric,
-            Quadric::ellipsoid(DVec3::Y, DVec3::splat(0.2))
-        );
+        assert_eq!(p[0].quadric, Quadric::ellipsoid(DVec3::Y, DVec3::splat(0.2)));
         assert_eq!(p[0].form_factor, 0.5);
-        assert_eq!(
-            p[1].quadric,
-            Quadric::ellipsoid(DVec3::X, DVec3::new(0.1, 0.2, 0.3))
-        );
+        assert_eq!(p[1].quadric, Quadric::ellipsoid(DVec3::X, DVec3::new(0.1, 0.2, 0.3)));
         assert_eq!(p[1].form_factor, -0.25);
         assert_eq!(p[2].quadric.coefficients()[9], 0.01);
         // The bump raises the surface above the pole.
@@ -1444,10 +1209,7 @@ mod tests {
         for (k, b) in p[1..1001].iter().enumerate() {
             assert!(near(centre(&b.quadric).length(), 2.0));
             assert_eq!(b.form_factor, if k % 2 == 0 { 0.8 } else { -0.8 });
-            assert!(near(
-                b.quadric.support_bounds().unwrap().unwrap().size().x,
-                0.1
-            ));
+            assert!(near(b.quadric.support_bounds().unwrap().unwrap().size().x, 0.1));
         }
         for b in &p[1001..] {
             let c = centre(&b.quadric) - DVec3::Y;
@@ -1477,15 +1239,10 @@ mod tests {
         assert_eq!(s.materials[1].albedo, Vec3::splat(0.8));
         assert_eq!(s.materials[1].emission, Vec3::splat(5.0));
         assert_eq!(s.materials[2].name, DEFAULT_MATERIAL_NAME);
-        assert_eq!(
-            s.objects.iter().map(|o| o.material).collect::<Vec<_>>(),
-            [1, 2, 2]
-        );
+        assert_eq!(s.objects.iter().map(|o| o.material).collect::<Vec<_>>(), [1, 2, 2]);
         assert_eq!(s.objects[1].name, "plain");
         // No default material when every object names one.
-        let s = parse(
-            "[[materials]]\nname = \"a\"\n[[objects]]\nsphere = { radius = 1 }\nmaterial = \"a\"\n",
-        );
+        let s = parse("[[materials]]\nname = \"a\"\n[[objects]]\nsphere = { radius = 1 }\nmaterial = \"a\"\n");
         assert_eq!(s.materials.len(), 1);
     }
 
@@ -1498,34 +1255,19 @@ mod tests {
         assert_eq!(
             s.lights,
             [
-                Light::Point {
-                    position: DVec3::new(1.0, 2.0, 3.0),
-                    intensity: Vec3::splat(10.0)
-                },
-                Light::Sphere {
-                    centre: DVec3::new(0.0, 5.0, 0.0),
-                    radius: 0.5,
-                    radiance: Vec3::new(4.0, 3.0, 2.0)
-                },
+                Light::Point { position: DVec3::new(1.0, 2.0, 3.0), intensity: Vec3::splat(10.0) },
+                Light::Sphere { centre: DVec3::new(0.0, 5.0, 0.0), radius: 0.5, radiance: Vec3::new(4.0, 3.0, 2.0) },
             ]
         );
     }
 
     #[test]
     fn camera() {
-        let s = parse_scene(
-            "[camera]\nposition = [1, 2, 3]\nlook_at = [0, 1, 0]\nup = [0, 0, 1]\nfov = 60\n",
-            "t",
-        )
-        .unwrap();
+        let s = parse_scene("[camera]\nposition = [1, 2, 3]\nlook_at = [0, 1, 0]\nup = [0, 0, 1]\nfov = 60\n", "t")
+            .unwrap();
         assert_eq!(
             s.camera,
-            Camera {
-                position: DVec3::new(1.0, 2.0, 3.0),
-                look_at: DVec3::Y,
-                up: DVec3::Z,
-                vfov_degrees: 60.0
-            }
+            Camera { position: DVec3::new(1.0, 2.0, 3.0), look_at: DVec3::Y, up: DVec3::Z, vfov_degrees: 60.0 }
         );
     }
 
@@ -1541,24 +1283,10 @@ mod tests {
 
     #[test]
     fn error_location_counts_characters() {
-        let e = parse_scene(
-            "# é\n[camera]\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\nfov = 200 # é\n",
-            "x.toml",
-        )
-        .unwrap_err();
-        let SceneError::Invalid {
-            line,
-            column,
-            ref field,
-            ..
-        } = e
-        else {
-            panic!("{e}")
-        };
+        let e = parse_scene("# é\n[camera]\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\nfov = 200 # é\n", "x.toml")
+            .unwrap_err();
+        let SceneError::Invalid { line, column, ref field, .. } = e else { panic!("{e}") };
         assert_eq!((line, column, field.as_str()), (5, 7, "camera.fov"));
-        assert!(
-            e.to_string().contains("\n5 | fov = 200 # é\n  |       ^^^"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("\n5 | fov = 200 # é\n  |       ^^^"), "{e}");
     }
 }

@@ -73,11 +73,9 @@ impl AccelerationStructure {
             device: device.clone(),
             raw,
             address: unsafe {
-                device
-                    .accel
-                    .get_acceleration_structure_device_address(
-                        &vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(raw),
-                    )
+                device.accel.get_acceleration_structure_device_address(
+                    &vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(raw),
+                )
             },
             buffer,
         };
@@ -106,7 +104,14 @@ impl AccelerationStructure {
     pub fn bottom_level_aabbs(device: &Arc<Device>, cmds: &mut Commands, aabbs: &[[f32; 6]]) -> Result<Self, VkError> {
         let positions: Vec<vk::AabbPositionsKHR> = aabbs
             .iter()
-            .map(|b| vk::AabbPositionsKHR { min_x: b[0], min_y: b[1], min_z: b[2], max_x: b[3], max_y: b[4], max_z: b[5] })
+            .map(|b| vk::AabbPositionsKHR {
+                min_x: b[0],
+                min_y: b[1],
+                min_z: b[2],
+                max_x: b[3],
+                max_y: b[4],
+                max_z: b[5],
+            })
             .collect();
         let bytes = unsafe {
             std::slice::from_raw_parts(positions.as_ptr() as *const u8, std::mem::size_of_val(positions.as_slice()))
@@ -124,14 +129,7 @@ impl AccelerationStructure {
             .geometry_type(vk::GeometryTypeKHR::AABBS)
             .flags(vk::GeometryFlagsKHR::OPAQUE)
             .geometry(vk::AccelerationStructureGeometryDataKHR { aabbs: data });
-        Self::build(
-            device,
-            cmds,
-            vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
-            geometry,
-            aabbs.len() as u32,
-            "blas",
-        )
+        Self::build(device, cmds, vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL, geometry, aabbs.len() as u32, "blas")
     }
 
     /// A top level over `instances`.
@@ -168,14 +166,7 @@ impl AccelerationStructure {
         let geometry = vk::AccelerationStructureGeometryKHR::default()
             .geometry_type(vk::GeometryTypeKHR::INSTANCES)
             .geometry(vk::AccelerationStructureGeometryDataKHR { instances: data });
-        Self::build(
-            device,
-            cmds,
-            vk::AccelerationStructureTypeKHR::TOP_LEVEL,
-            geometry,
-            instances.len() as u32,
-            "tlas",
-        )
+        Self::build(device, cmds, vk::AccelerationStructureTypeKHR::TOP_LEVEL, geometry, instances.len() as u32, "tlas")
     }
 }
 

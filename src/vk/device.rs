@@ -11,11 +11,8 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use super::{Instance, VkError};
 
 /// The device extensions the renderer cannot work without.
-const REQUIRED_EXTENSIONS: [&CStr; 3] = [
-    ash::khr::acceleration_structure::NAME,
-    ash::khr::ray_query::NAME,
-    ash::khr::deferred_host_operations::NAME,
-];
+const REQUIRED_EXTENSIONS: [&CStr; 3] =
+    [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME];
 
 /// The command that installs a driver with ray queries.
 pub const SETUP_HINT: &str =
@@ -103,7 +100,9 @@ impl Device {
     /// When none fits, the error lists every device seen and what it lacks.
     pub fn new(instance: Arc<Instance>) -> Result<Arc<Self>, VkError> {
         let raw_instance = &instance.raw;
-        let devices = unsafe { raw_instance.enumerate_physical_devices() }?;
+        let devices = unsafe { raw_instance.enumerate_physical_devices() }.map_err(|e| {
+            VkError::NoSuitableDevice(format!("the Vulkan driver lists no devices ({e}).\nTo fix: {SETUP_HINT}"))
+        })?;
         let mut report = Vec::new();
         let mut fits = Vec::new();
         for &pd in &devices {
@@ -138,7 +137,8 @@ impl Device {
             .position(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE))
             .expect("checked in shortcomings") as u32;
         let priorities = [1.0f32];
-        let queue_info = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let queue_info =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
         let ext_names: Vec<_> = REQUIRED_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
 
         let mut supported12 = vk::PhysicalDeviceVulkan12Features::default();
@@ -170,8 +170,9 @@ impl Device {
         let mut as_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut as_props);
         unsafe { raw_instance.get_physical_device_properties2(physical, &mut props2) };
-        let accel_properties =
-            AccelProperties { min_scratch_offset_alignment: as_props.min_acceleration_structure_scratch_offset_alignment };
+        let accel_properties = AccelProperties {
+            min_scratch_offset_alignment: as_props.min_acceleration_structure_scratch_offset_alignment,
+        };
 
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: raw_instance.clone(),

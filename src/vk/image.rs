@@ -43,14 +43,8 @@ impl Image {
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let raw = unsafe { device.raw.create_image(&info, None) }?;
-        let mut this = Self {
-            device: device.clone(),
-            raw,
-            view: vk::ImageView::null(),
-            allocation: None,
-            format,
-            extent,
-        };
+        let mut this =
+            Self { device: device.clone(), raw, view: vk::ImageView::null(), allocation: None, format, extent };
         let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
         let allocation = device
             .allocator
@@ -76,10 +70,7 @@ impl Image {
     }
 
     fn whole() -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange::default()
-            .aspect_mask(vk::ImageAspectFlags::COLOR)
-            .level_count(1)
-            .layer_count(1)
+        vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1)
     }
 
     /// Records a transition from `from` to `to`, making all earlier
@@ -120,14 +111,15 @@ impl Image {
         };
     }
 
-    /// Records copying the (GENERAL layout) image into `buffer`, tightly packed.
-    pub fn copy_to_buffer(&self, cmd: vk::CommandBuffer, buffer: &Buffer) {
+    /// Records copying the image, in `layout` (GENERAL or TRANSFER_SRC_OPTIMAL),
+    /// into `buffer`, tightly packed.
+    pub fn copy_to_buffer(&self, cmd: vk::CommandBuffer, layout: vk::ImageLayout, buffer: &Buffer) {
         let region = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1))
+            .image_subresource(
+                vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1),
+            )
             .image_extent(vk::Extent3D { width: self.extent.width, height: self.extent.height, depth: 1 });
-        unsafe {
-            self.device.raw.cmd_copy_image_to_buffer(cmd, self.raw, vk::ImageLayout::GENERAL, buffer.raw, &[region])
-        };
+        unsafe { self.device.raw.cmd_copy_image_to_buffer(cmd, self.raw, layout, buffer.raw, &[region]) };
     }
 }
 

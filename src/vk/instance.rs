@@ -40,8 +40,6 @@ pub struct Instance {
     pub raw: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     counters: Arc<ValidationCounters>,
-    // Keeps the callback's user data alive as long as the messenger.
-    _callback_data: Box<Arc<ValidationCounters>>,
 }
 
 impl Instance {
@@ -58,9 +56,8 @@ impl Instance {
         let mut extensions = Vec::new();
         if validation {
             let available = unsafe { entry.enumerate_instance_layer_properties() }?;
-            let found = available
-                .iter()
-                .any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
+            let found =
+                available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
             if !found {
                 return Err(VkError::MissingValidationLayer);
             }
@@ -69,7 +66,6 @@ impl Instance {
         }
 
         let counters = Arc::new(ValidationCounters::default());
-        let callback_data = Box::new(counters.clone());
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
             .message_severity(
                 vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
@@ -82,7 +78,7 @@ impl Instance {
                     | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
             )
             .pfn_user_callback(Some(debug_callback))
-            .user_data(&*callback_data as *const Arc<ValidationCounters> as *mut c_void);
+            .user_data(Arc::as_ptr(&counters) as *mut c_void);
 
         let mut info = vk::InstanceCreateInfo::default()
             .application_info(&app)
@@ -92,7 +88,16 @@ impl Instance {
             // Also report problems in vkCreateInstance / vkDestroyInstance.
             info = info.push_next(&mut messenger_info);
         }
-        let raw = unsafe { entry.create_instance(&info, None) }?;
+        let raw = match unsafe { entry.create_instance(&info, None) } {
+            Ok(raw) => raw,
+            Err(e @ (vk::Result::ERROR_INCOMPATIBLE_DRIVER | vk::Result::ERROR_INITIALIZATION_FAILED)) => {
+                return Err(VkError::NoSuitableDevice(format!(
+                    "the Vulkan loader found no working driver (ICD) ({e}).\nTo fix: {}",
+                    super::SETUP_HINT
+                )))
+            }
+            Err(e) => return Err(e.into()),
+        };
 
         let debug = if validation {
             let loader = ash::ext::debug_utils::Instance::new(&entry, &raw);
@@ -101,7 +106,7 @@ impl Instance {
         } else {
             None
         };
-        Ok(Self { entry, raw, debug, counters, _callback_data: callback_data })
+        Ok(Self { entry, raw, debug, counters })
     }
 
     /// The validation message counters (shared; outlive the instance).
@@ -137,7 +142,8 @@ unsafe extern "system" fn debug_callback(
     } else {
         CStr::from_ptr((*data).p_message).to_string_lossy()
     };
-    let counters = (user as *const Arc<ValidationCounters>).as_ref();
+    // `user` points into the instance's Arc, which outlives the messenger.
+    let counters = (user as *const ValidationCounters).as_ref();
     if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
         if let Some(c) = counters {
             c.errors.fetch_add(1, Ordering::SeqCst);

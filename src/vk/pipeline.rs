@@ -147,8 +147,9 @@ impl ComputePipeline {
                 Binding::Buffer(b) => {
                     buffer_infos.push([vk::DescriptorBufferInfo::default().buffer(b.raw).range(vk::WHOLE_SIZE)])
                 }
-                Binding::Image(i) => image_infos
-                    .push([vk::DescriptorImageInfo::default().image_view(i.view).image_layout(vk::ImageLayout::GENERAL)]),
+                Binding::Image(i) => image_infos.push([vk::DescriptorImageInfo::default()
+                    .image_view(i.view)
+                    .image_layout(vk::ImageLayout::GENERAL)]),
                 Binding::AccelerationStructure(a) => as_handles.push([a.raw]),
             }
         }
@@ -163,7 +164,8 @@ impl ComputePipeline {
             let base = vk::WriteDescriptorSet::default().dst_set(self.set).dst_binding(i as u32);
             match (r, self.bindings[i]) {
                 (Binding::Buffer(_), BindingKind::StorageBuffer) => {
-                    writes.push(base.descriptor_type(vk::DescriptorType::STORAGE_BUFFER).buffer_info(&buffer_infos[bi]));
+                    writes
+                        .push(base.descriptor_type(vk::DescriptorType::STORAGE_BUFFER).buffer_info(&buffer_infos[bi]));
                     bi += 1;
                 }
                 (Binding::Image(_), BindingKind::StorageImage) => {

@@ -28,9 +28,7 @@ impl Timestamps {
 
     /// Records timestamp `index` after all previous work has finished.
     pub fn write(&self, cmd: vk::CommandBuffer, index: u32) {
-        unsafe {
-            self.device.raw.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, index)
-        };
+        unsafe { self.device.raw.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, index) };
     }
 
     /// Reads all timestamps (waiting for them) in nanoseconds.

@@ -119,6 +119,10 @@ pub fn test_objects() -> Vec<SceneObject> {
         ),
         object("floor", floor, DAffine3::IDENTITY),
         object("cone", cone, placement(DVec3::ONE, DVec3::new(0.0, 0.0, 180.0), DVec3::new(0.5, 1.3, 2.5))),
-        object("paraboloid", paraboloid, placement(DVec3::splat(1.2), DVec3::new(0.0, 0.0, 0.0), DVec3::new(-1.0, 0.2, -3.0))),
+        object(
+            "paraboloid",
+            paraboloid,
+            placement(DVec3::splat(1.2), DVec3::new(0.0, 0.0, 0.0), DVec3::new(-1.0, 0.2, -3.0)),
+        ),
     ]
 }

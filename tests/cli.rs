@@ -1,0 +1,505 @@
+//! The `quadray` binary end to end, always with the Khronos validation layer
+//! (the command fails if the layer reports an error):
+//!
+//! - a unit sphere seen from (0, 0, 5): the EXR's AOVs match the analytic
+//!   ray-sphere intersection of every pixel-centre ray (depth, world-space
+//!   normal, albedo; +inf, 0, 0 on a miss), the radiance is finite, equals
+//!   the background on misses, zero on the side facing away from the point
+//!   light and the Lambert value on the lit side; the PNG has the scene's
+//!   size and the tone-mapped background;
+//! - `--half` writes half-float channels, `-o NAME.exr` / `-o NAME.png` only
+//!   that file, the size flags override the scene, `QUADRAY_VALIDATION=1`
+//!   turns the layer on;
+//! - bad scene files, a missing scene file, a missing output directory and an
+//!   output that cannot be renamed into place fail with a message naming the
+//!   file (and line) and leave nothing behind, not even a temporary file.
+//!
+//! Without a Vulkan device with ray queries these tests fail with the
+//! binary's message (run `make setup`).
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+use exr::prelude::{read_all_flat_layers_from_file, AnyChannels, FlatSamples, Layer};
+
+/// A unit sphere at the origin, the camera on +z looking at it.
+const SPHERE_SCENE: &str = r#"# A unit sphere for tests/cli.rs; the test computes every pixel analytically.
+background = [0.1, 0.2, 0.3]
+
+[image]
+width = 40
+height = 30
+spp = 2
+seed = 3
+exposure = 1.0
+
+[camera]
+position = [0, 0, 5]
+look_at = [0, 0, 0]
+fov = 30
+
+[[materials]]
+name = "paint"
+albedo = [0.6, 0.4, 0.2]
+
+[[objects]]
+name = "ball"
+material = "paint"
+sphere = { radius = 1 }
+
+[[lights]]
+type = "point"
+position = [4, 2, 2]
+intensity = [20, 20, 20]
+"#;
+
+const WIDTH: usize = 40;
+const HEIGHT: usize = 30;
+const EYE: [f64; 3] = [0.0, 0.0, 5.0];
+const FOV_DEGREES: f64 = 30.0;
+const ALBEDO: [f32; 3] = [0.6, 0.4, 0.2];
+const BACKGROUND: [f32; 3] = [0.1, 0.2, 0.3];
+const EXPOSURE: f32 = 1.0;
+const LIGHT: [f64; 3] = [4.0, 2.0, 2.0];
+const INTENSITY: f64 = 20.0;
+
+/// Command-line arguments from strings and paths, as `&[OsString]`.
+macro_rules! args {
+    ($($a:expr),* $(,)?) => {
+        &[$(std::ffi::OsString::from($a)),*][..]
+    };
+}
+
+/// Runs the binary in `cwd` with a clean environment for its error output.
+fn quadray<S: AsRef<OsStr>>(args: &[S], cwd: &Path, envs: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_quadray"));
+    cmd.args(args)
+        .current_dir(cwd)
+        .stdin(Stdio::null())
+        .env("RUST_BACKTRACE", "0")
+        .env_remove("RUST_LIB_BACKTRACE")
+        .env_remove("QUADRAY_VALIDATION");
+    for (k, v) in envs {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("cannot start the quadray binary")
+}
+
+fn describe<S: AsRef<OsStr>>(args: &[S]) -> String {
+    args.iter().map(|a| a.as_ref().to_string_lossy().into_owned()).collect::<Vec<_>>().join(" ")
+}
+
+/// Runs the binary and fails the test with its stderr unless it succeeds.
+#[track_caller]
+fn render_ok<S: AsRef<OsStr>>(args: &[S], cwd: &Path, envs: &[(&str, &str)]) -> String {
+    let out = quadray(args, cwd, envs);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        out.status.success(),
+        "`quadray {}` failed ({}); a Vulkan device with ray queries and the validation layer are needed \
+         (run `make setup`):\n{stderr}",
+        describe(args),
+        out.status
+    );
+    stderr
+}
+
+/// Runs the binary, expects it to fail and returns its stderr.
+#[track_caller]
+fn render_fails<S: AsRef<OsStr>>(args: &[S], cwd: &Path) -> String {
+    let out = quadray(args, cwd, &[]);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "`quadray {}` should have failed; stderr:\n{stderr}", describe(args));
+    assert!(!stderr.contains("panicked"), "a panic instead of an error message:\n{stderr}");
+    stderr
+}
+
+/// Sorted names of the entries of `dir` (hidden ones included).
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}
+
+fn write_scene(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The only layer of an EXR file, with its channels by name.
+struct Exr {
+    layer: Layer<AnyChannels<FlatSamples>>,
+}
+
+impl Exr {
+    fn read(path: &Path) -> Self {
+        let image = read_all_flat_layers_from_file(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!(image.layer_data.len(), 1, "one layer");
+        Self { layer: image.layer_data.into_iter().next().unwrap() }
+    }
+
+    fn size(&self) -> (usize, usize) {
+        (self.layer.size.x(), self.layer.size.y())
+    }
+
+    fn names(&self) -> Vec<String> {
+        let mut n: Vec<String> = self.layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
+        n.sort();
+        n
+    }
+
+    fn samples(&self, name: &str) -> &FlatSamples {
+        &self
+            .layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.eq(name))
+            .unwrap_or_else(|| panic!("no channel {name}"))
+            .sample_data
+    }
+
+    /// A channel as f32, row 0 at the top.
+    fn channel(&self, name: &str) -> Vec<f32> {
+        self.samples(name).values_as_f32().collect()
+    }
+
+    fn vec3(&self, names: [&str; 3]) -> Vec<[f32; 3]> {
+        let [a, b, c] = names.map(|n| self.channel(n));
+        (0..a.len()).map(|i| [a[i], b[i], c[i]]).collect()
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let l = dot(a, a).sqrt();
+    [a[0] / l, a[1] / l, a[2] / l]
+}
+
+/// What the pixel-centre ray of pixel (x, y) sees in `SPHERE_SCENE`,
+/// computed in f64 from the camera model of README.md: forward (0, 0, -1),
+/// right (1, 0, 0) scaled by tan(fov/2)·aspect, up (0, 1, 0) scaled by
+/// tan(fov/2), pixel centres at i + ½, row 0 at the top.
+struct Expected {
+    /// Distance from the ray to the sphere's centre (1 = grazing).
+    miss_distance: f64,
+    /// Distance along the unit ray to the first hit.
+    hit: Option<(f64, [f64; 3])>,
+}
+
+fn expected(x: usize, y: usize, width: usize, height: usize) -> Expected {
+    let half = (0.5 * FOV_DEGREES).to_radians().tan();
+    let aspect = width as f64 / height as f64;
+    let ndc_x = 2.0 * (x as f64 + 0.5) / width as f64 - 1.0;
+    let ndc_y = 1.0 - 2.0 * (y as f64 + 0.5) / height as f64;
+    let d = normalize([ndc_x * half * aspect, ndc_y * half, -1.0]);
+    // |eye + s d|² = 1  <=>  s² + 2 b s + |eye|² - 1 = 0 with b = eye · d.
+    let b = dot(EYE, d);
+    let c = dot(EYE, EYE) - 1.0;
+    let miss_distance = (dot(EYE, EYE) - b * b).max(0.0).sqrt();
+    let disc = b * b - c;
+    let hit = (disc >= 0.0).then(|| {
+        let s = -b - disc.sqrt();
+        let p = [EYE[0] + s * d[0], EYE[1] + s * d[1], EYE[2] + s * d[2]];
+        (s, p) // on the unit sphere the point is its own outward normal
+    });
+    Expected { miss_distance, hit }
+}
+
+fn srgb8(v: f32) -> u8 {
+    let v = v.clamp(0.0, 1.0);
+    let e = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+    (e * 255.0 + 0.5) as u8
+}
+
+#[test]
+fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
+    let input = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let scene = write_scene(input.path(), "sphere.toml", SPHERE_SCENE);
+    let base = outdir.path().join("out");
+    let stderr = render_ok(args!["render", &scene, "-o", &base, "--validation"], outdir.path(), &[]);
+    assert!(stderr.contains("wrote"), "{stderr}");
+    assert_eq!(entries(outdir.path()), ["out.exr", "out.png"]);
+
+    let exr = Exr::read(&outdir.path().join("out.exr"));
+    assert_eq!(exr.size(), (WIDTH, HEIGHT));
+    let mut want = quadray::output::EXR_CHANNELS.map(String::from).to_vec();
+    want.sort();
+    assert_eq!(exr.names(), want);
+    for name in quadray::output::EXR_CHANNELS {
+        assert!(matches!(exr.samples(name), FlatSamples::F32(_)), "{name} should hold 32-bit floats");
+    }
+    let depth = exr.channel("depth");
+    let normal = exr.vec3(["normal.X", "normal.Y", "normal.Z"]);
+    let albedo = exr.vec3(["albedo.R", "albedo.G", "albedo.B"]);
+    let rgb = exr.vec3(["R", "G", "B"]);
+
+    // A pixel covers about 2·tan(15°)·5/30 ≈ 0.09 at the sphere; radiance
+    // (jittered inside the pixel) is checked only where the whole pixel
+    // agrees, the AOVs (pixel centre) wherever the ray is not grazing.
+    let pixel = 2.0 * (0.5 * FOV_DEGREES).to_radians().tan() * EYE[2] / HEIGHT as f64;
+    let (mut hits, mut misses, mut lit, mut dark) = (0, 0, 0, 0);
+    let mut max_depth_error = 0f64;
+    let mut max_normal_error = 0f64;
+    let mut max_lit_error = 0f64;
+    for y in 0..HEIGHT {
+        for x in 0..WIDTH {
+            let i = y * WIDTH + x;
+            let at = format!("pixel ({x}, {y})");
+            assert!(rgb[i].iter().all(|v| v.is_finite() && *v >= 0.0), "{at}: radiance {:?}", rgb[i]);
+            let e = expected(x, y, WIDTH, HEIGHT);
+            if (e.miss_distance - 1.0).abs() < 1e-3 {
+                continue; // grazing: either answer is right
+            }
+            match e.hit {
+                None => {
+                    misses += 1;
+                    assert_eq!(depth[i], f32::INFINITY, "{at}: depth of a miss");
+                    assert_eq!(normal[i], [0.0; 3], "{at}: normal of a miss");
+                    assert_eq!(albedo[i], [0.0; 3], "{at}: albedo of a miss");
+                    if e.miss_distance > 1.0 + 1.5 * pixel {
+                        for k in 0..3 {
+                            assert!((rgb[i][k] - BACKGROUND[k]).abs() < 1e-6, "{at}: background {:?}", rgb[i]);
+                        }
+                    }
+                }
+                Some((t, n)) => {
+                    hits += 1;
+                    let err = (depth[i] as f64 - t).abs();
+                    max_depth_error = max_depth_error.max(err);
+                    assert!(err < 1e-5 * t, "{at}: depth {} expected {t}", depth[i]);
+                    let got = normal[i].map(|v| v as f64);
+                    let nerr = sub(got, n).iter().fold(0f64, |m, v| m.max(v.abs()));
+                    max_normal_error = max_normal_error.max(nerr);
+                    assert!(nerr < 1e-4, "{at}: normal {got:?} expected {n:?}");
+                    for k in 0..3 {
+                        assert!((albedo[i][k] - ALBEDO[k]).abs() < 1e-6, "{at}: albedo {:?}", albedo[i]);
+                    }
+                    // Lambert: albedo / π · I cos θ / r², where the whole
+                    // pixel sees the sphere's front.
+                    let to_light = sub(LIGHT, n);
+                    let r2 = dot(to_light, to_light);
+                    let cos = dot(n, normalize(to_light));
+                    if n[2] > 0.5 && cos > 0.5 {
+                        lit += 1;
+                        for k in 0..3 {
+                            let want = ALBEDO[k] as f64 / std::f64::consts::PI * INTENSITY * cos / r2;
+                            let rel = (rgb[i][k] as f64 - want).abs() / want;
+                            max_lit_error = max_lit_error.max(rel);
+                            assert!(rel < 0.15, "{at}: radiance {:?}, Lambert gives {want} in channel {k}", rgb[i]);
+                        }
+                    } else if n[2] > 0.5 && cos < -0.2 {
+                        dark += 1;
+                        assert_eq!(rgb[i], [0.0; 3], "{at}: facing away from the only light");
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "{hits} hits ({lit} lit, {dark} dark), {misses} misses; max depth error {max_depth_error:.2e}, \
+         max normal error {max_normal_error:.2e}, max Lambert error {:.1}%",
+        100.0 * max_lit_error
+    );
+    assert!(hits > 200 && misses > 200 && lit > 20 && dark > 20, "the scene should show all cases");
+
+    // The first pixel-centre ray near the image centre (the width and the
+    // height are even, so no ray is on the axis).
+    let e = expected(WIDTH / 2, HEIGHT / 2, WIDTH, HEIGHT);
+    let (t, _) = e.hit.unwrap();
+    assert!((t - 4.0).abs() < 0.01, "near-axis depth {t}");
+    assert!((depth[HEIGHT / 2 * WIDTH + WIDTH / 2] as f64 - t).abs() < 1e-4);
+
+    // The PNG: the scene's size, the background tone-mapped with the
+    // scene's exposure of 1 stop.
+    let png = image::open(outdir.path().join("out.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (WIDTH as u32, HEIGHT as u32));
+    let png = png.to_rgb8();
+    let corner = png.get_pixel(0, 0).0;
+    let want = BACKGROUND.map(|v| srgb8(v * EXPOSURE.exp2()));
+    for k in 0..3 {
+        assert!(corner[k].abs_diff(want[k]) <= 1, "PNG corner {corner:?}, expected {want:?}");
+    }
+}
+
+#[test]
+fn half_exr_only_with_size_overrides_and_validation_from_the_environment() {
+    let input = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let scene = write_scene(input.path(), "sphere.toml", SPHERE_SCENE);
+    let out = outdir.path().join("half.exr");
+    let (w, h) = (20, 16);
+    render_ok(
+        args![
+            "render", &scene, "--output", &out, "--half", "--width", "20", "--height", "16", "--spp", "1", "--seed",
+            "9"
+        ],
+        outdir.path(),
+        &[("QUADRAY_VALIDATION", "1")],
+    );
+    assert_eq!(entries(outdir.path()), ["half.exr"]);
+    let exr = Exr::read(&out);
+    assert_eq!(exr.size(), (w, h));
+    for name in quadray::output::EXR_CHANNELS {
+        assert!(matches!(exr.samples(name), FlatSamples::F16(_)), "{name} should hold half floats");
+    }
+    let depth = exr.channel("depth");
+    assert_eq!(depth[0], f32::INFINITY, "corner pixel misses");
+    let (cx, cy) = (w / 2, h / 2);
+    let (t, n) = expected(cx, cy, w, h).hit.unwrap();
+    let i = cy * w + cx;
+    assert!((depth[i] as f64 - t).abs() < 4e-3, "depth {} expected {t}", depth[i]);
+    assert!((exr.channel("normal.Z")[i] as f64 - n[2]).abs() < 2e-3);
+    assert!((exr.channel("albedo.R")[i] - ALBEDO[0]).abs() < 1e-3);
+    for name in ["R", "G", "B"] {
+        assert!(exr.channel(name).iter().all(|v| v.is_finite() && *v >= 0.0), "{name} has NaN, Inf or negatives");
+    }
+}
+
+#[test]
+fn png_only_of_the_default_scene() {
+    let outdir = tempfile::tempdir().unwrap();
+    let out = outdir.path().join("only.PNG");
+    // No scene argument: the built-in default scene, made small.
+    render_ok(
+        &["render", "-o", out.to_str().unwrap(), "--width", "24", "--height", "18", "--spp", "1", "--validation"],
+        outdir.path(),
+        &[],
+    );
+    assert_eq!(entries(outdir.path()), ["only.PNG"]);
+    let png = image::open(&out).unwrap();
+    assert_eq!((png.width(), png.height()), (24, 18));
+}
+
+/// Writes `text` as `name`, renders it into an empty directory and checks
+/// the error names the file and `line` and contains every needle, and that
+/// the directory stays empty.
+#[track_caller]
+fn bad_scene(name: &str, text: &str, line: usize, needles: &[&str]) {
+    let input = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let scene = write_scene(input.path(), name, text);
+    let base = outdir.path().join("out");
+    let stderr = render_fails(args!["render", &scene, "-o", &base, "--validation"], outdir.path());
+    let location = format!("{}:{line}:", scene.display());
+    assert!(stderr.contains(&location), "expected `{location}` in\n{stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "expected `{n}` in\n{stderr}");
+    }
+    assert!(entries(outdir.path()).is_empty(), "files left behind: {:?}", entries(outdir.path()));
+}
+
+#[test]
+fn bad_scene_files_fail_with_file_line_and_reason_and_write_nothing() {
+    let camera = "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n";
+    bad_scene(
+        "negative_radius.toml",
+        &format!("{camera}\n[[objects]]\nsphere = {{ radius = -1 }}\n"),
+        6,
+        &["objects[0].sphere.radius", "must be positive (got -1)"],
+    );
+    bad_scene(
+        "unknown_key.toml",
+        &format!("{camera}[image]\nwidht = 5\n"),
+        5,
+        &["image.widht", "unknown field `widht`"],
+    );
+    bad_scene(
+        "unbounded.toml",
+        &format!("{camera}[[objects]]\nplane = {{}}\n"),
+        5,
+        &["objects[0].plane", "unbounded", "clip"],
+    );
+}
+
+#[test]
+fn a_missing_scene_file_is_named() {
+    let input = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let scene = input.path().join("no_such_scene.toml");
+    let base = outdir.path().join("out");
+    let stderr = render_fails(args!["render", &scene, "-o", &base], outdir.path());
+    assert!(stderr.contains(&scene.display().to_string()), "{stderr}");
+    assert!(stderr.contains("cannot read"), "{stderr}");
+    assert!(entries(outdir.path()).is_empty());
+}
+
+#[test]
+fn a_missing_output_directory_is_an_error() {
+    let input = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let scene = write_scene(input.path(), "sphere.toml", SPHERE_SCENE);
+    let missing = outdir.path().join("missing").join("sub");
+    let base = missing.join("out");
+    let stderr = render_fails(args!["render", &scene, "-o", &base, "--validation"], outdir.path());
+    assert!(stderr.contains(&format!("output directory {} does not exist", missing.display())), "{stderr}");
+    assert!(entries(outdir.path()).is_empty(), "files left behind: {:?}", entries(outdir.path()));
+}
+
+#[test]
+fn a_failed_write_leaves_no_file_at_all() {
+    // out.exr is a directory, so the EXR cannot be put in place after the
+    // render: neither the PNG nor any temporary file may be left.
+    let input = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let scene = write_scene(input.path(), "sphere.toml", SPHERE_SCENE);
+    let taken = outdir.path().join("out.exr");
+    std::fs::create_dir(&taken).unwrap();
+    let base = outdir.path().join("out");
+    let stderr = render_fails(
+        args!["render", &scene, "-o", &base, "--width", "8", "--height", "6", "--validation"],
+        outdir.path(),
+    );
+    assert!(stderr.contains(&format!("cannot write {}", taken.display())), "{stderr}");
+    assert_eq!(entries(outdir.path()), ["out.exr"]);
+    assert!(entries(&taken).is_empty());
+}
+
+#[test]
+fn an_output_directory_instead_of_a_name_is_an_error() {
+    let input = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let scene = write_scene(input.path(), "sphere.toml", SPHERE_SCENE);
+    let stderr = render_fails(args!["render", &scene, "-o", outdir.path(), "--validation"], outdir.path());
+    assert!(stderr.contains("give a file name"), "{stderr}");
+    assert!(entries(outdir.path()).is_empty(), "files left behind: {:?}", entries(outdir.path()));
+}
+
+#[test]
+fn without_a_vulkan_driver_the_error_says_how_to_install_one() {
+    let outdir = tempfile::tempdir().unwrap();
+    let out = quadray(&["render", "-o", "x"], outdir.path(), &[("VK_ICD_FILENAMES", "/nonexistent/icd.json")]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("no Vulkan device supports ray queries"), "{stderr}");
+    assert!(stderr.contains("make setup"), "{stderr}");
+    assert!(entries(outdir.path()).is_empty());
+}
+
+#[test]
+fn quadray_validation_in_the_environment_asks_for_the_layer() {
+    // With no layer on the search path, asking for validation must fail
+    // before anything is rendered; QUADRAY_VALIDATION=0 does not ask.
+    let layers = tempfile::tempdir().unwrap();
+    let outdir = tempfile::tempdir().unwrap();
+    let no_layers = layers.path().to_str().unwrap();
+    let args = ["render", "-o", "out", "--width", "8", "--height", "6", "--spp", "1"];
+    let out = quadray(&args, outdir.path(), &[("QUADRAY_VALIDATION", "1"), ("VK_LAYER_PATH", no_layers)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "validation was not asked for:\n{stderr}");
+    assert!(stderr.contains("validation layer is not installed"), "{stderr}");
+    assert!(entries(outdir.path()).is_empty());
+    render_ok(&args, outdir.path(), &[("QUADRAY_VALIDATION", "0"), ("VK_LAYER_PATH", no_layers)]);
+    assert_eq!(entries(outdir.path()), ["out.exr", "out.png"]);
+}
