@@ -70,7 +70,7 @@ pub struct CellParams {
 
 impl Default for CellParams {
     fn default() -> Self {
-        Self { max_perturbations: 16, max_depth: 18, tighten_depth: 6, padding: 1e-5 }
+        Self { max_perturbations: 8, max_depth: 18, tighten_depth: 6, padding: 1e-5 }
     }
 }
 
