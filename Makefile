@@ -33,7 +33,7 @@ run: setup
 # The test profile builds at opt-level 2 (Cargo.toml), so no release build is
 # needed; the tests turn the Vulkan validation layer on.
 test: setup
-	$(CARGO) test
+	$(CARGO) test -- --show-output
 
 bench: setup
 	$(CARGO) bench --bench perturbations
