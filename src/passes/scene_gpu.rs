@@ -157,6 +157,8 @@ impl GpuScene {
                     color: radiance.to_array(),
                     kind: LIGHT_SPHERE,
                 },
+                // Not rendered yet by render.comp (the path tracer of issue 3 adds them).
+                Light::Rect { .. } | Light::Directional { .. } => GpuLight::default(),
             })
             .collect();
 

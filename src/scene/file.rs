@@ -27,7 +27,7 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::{Camera, ImageSettings, Light, Material, Scene, SceneObject};
+use super::{Camera, ImageSettings, Light, Material, MaterialKind, Scene, SceneObject};
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 
 /// The file name used in messages about [`DEFAULT_SCENE`].
@@ -652,6 +652,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         spp: image.and_then(|i| i.spp).map_or(16, |v| v.get() as u32),
         seed: image.and_then(|i| i.seed).map_or(0, |v| v.get() as u32),
         exposure: image.and_then(|i| i.exposure).map_or(0.0, |v| v.get() as f32),
+        max_depth: 1,
     };
     let camera = build_camera(src, &raw.camera)?;
     let background = raw.background.map_or(Vec3::ZERO, |b| b.get().as_vec3());
@@ -676,6 +677,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         material_lines.push(src.text[..span.start.min(src.text.len())].matches('\n').count() + 1);
         materials.push(Material {
             name: name.clone(),
+            kind: MaterialKind::Diffuse,
             albedo: m.albedo.map_or(Vec3::splat(0.8), |a| a.get().as_vec3()),
             emission: m.emission.map_or(Vec3::ZERO, |e| e.get().as_vec3()),
         });
@@ -704,11 +706,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
             },
             None => {
                 if materials.len() == user_materials {
-                    materials.push(Material {
-                        name: DEFAULT_MATERIAL_NAME.to_owned(),
-                        albedo: Vec3::splat(0.8),
-                        emission: Vec3::ZERO,
-                    });
+                    materials.push(Material::diffuse(DEFAULT_MATERIAL_NAME, Vec3::splat(0.8)));
                 }
                 user_materials
             }
@@ -1073,7 +1071,7 @@ mod tests {
     #[test]
     fn defaults() {
         let s = parse("");
-        assert_eq!(s.image, ImageSettings { width: 640, height: 480, spp: 16, seed: 0, exposure: 0.0 });
+        assert_eq!(s.image, ImageSettings { width: 640, height: 480, spp: 16, seed: 0, exposure: 0.0, max_depth: 1 });
         assert_eq!(s.camera.up, DVec3::Y);
         assert_eq!(s.camera.vfov_degrees, 40.0);
         assert_eq!(s.background, Vec3::ZERO);
@@ -1084,7 +1082,10 @@ mod tests {
     fn image_and_background() {
         let text = "background = [0.1, 0.2, 0.3]\n[image]\nwidth = 64\nheight = 48\nspp = 3\nseed = 4000000000\nexposure = -1.5\n";
         let s = parse_scene(&format!("{text}{CAMERA}"), "t.toml").unwrap();
-        assert_eq!(s.image, ImageSettings { width: 64, height: 48, spp: 3, seed: 4_000_000_000, exposure: -1.5 });
+        assert_eq!(
+            s.image,
+            ImageSettings { width: 64, height: 48, spp: 3, seed: 4_000_000_000, exposure: -1.5, max_depth: 1 }
+        );
         assert_eq!(s.background, Vec3::new(0.1, 0.2, 0.3));
     }
 

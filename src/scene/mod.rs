@@ -36,17 +36,71 @@ pub struct ImageSettings {
     pub seed: u32,
     /// Exposure in stops applied before tone mapping the PNG.
     pub exposure: f32,
+    /// Longest light path, in bounces (1 = direct lighting only).
+    pub max_depth: u32,
 }
 
-/// A Lambertian material, possibly emissive.
+/// How a surface scatters light.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialKind {
+    /// Lambertian reflection of [`Material::albedo`].
+    Diffuse,
+    /// A GGX microfacet metal (Smith height-correlated masking, visible-normal
+    /// sampling).
+    Conductor {
+        /// Perceptual roughness in [0, 1]; the GGX α is roughness².
+        roughness: f32,
+        /// The conductor's Fresnel reflectance.
+        fresnel: ConductorFresnel,
+    },
+    /// Glass or water: Fresnel reflection and refraction, smooth when
+    /// `roughness` is 0, GGX rough otherwise (Walter et al. 2007).
+    Dielectric {
+        /// Perceptual roughness in [0, 1].
+        roughness: f32,
+        /// Index of refraction of the inside relative to vacuum (> 0).
+        ior: f32,
+    },
+    /// A perfect mirror reflecting [`Material::albedo`].
+    Mirror,
+}
+
+/// Fresnel reflectance of a conductor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConductorFresnel {
+    /// Exact conductor Fresnel from the complex index of refraction η + iκ per RGB channel.
+    Complex {
+        /// Real part η.
+        eta: Vec3,
+        /// Extinction κ.
+        k: Vec3,
+    },
+    /// Schlick's approximation from the reflectance at normal incidence
+    /// (an artist colour).
+    Schlick {
+        /// Reflectance at normal incidence.
+        f0: Vec3,
+    },
+}
+
+/// A material: how it scatters light, and what it emits.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// Name used by objects to refer to it.
     pub name: String,
-    /// Diffuse reflectance (linear RGB, each in [0, 1]).
+    /// Scattering model.
+    pub kind: MaterialKind,
+    /// Diffuse reflectance (diffuse) or reflectance (mirror); linear RGB, each in [0, 1].
     pub albedo: Vec3,
     /// Emitted radiance (linear RGB).
     pub emission: Vec3,
+}
+
+impl Material {
+    /// A Lambertian material.
+    pub fn diffuse(name: &str, albedo: Vec3) -> Self {
+        Self { name: name.into(), kind: MaterialKind::Diffuse, albedo, emission: Vec3::ZERO }
+    }
 }
 
 /// A functional object placed in the world.
@@ -81,6 +135,25 @@ pub enum Light {
         /// Emitted radiance.
         radiance: Vec3,
     },
+    /// A one-sided parallelogram light: points `corner + a edge_u + b edge_v`,
+    /// a and b in [0, 1], emitting toward `edge_u × edge_v`.
+    Rect {
+        /// One corner.
+        corner: DVec3,
+        /// First edge.
+        edge_u: DVec3,
+        /// Second edge.
+        edge_v: DVec3,
+        /// Emitted radiance.
+        radiance: Vec3,
+    },
+    /// A distant light (the sun): parallel light arriving from `direction`.
+    Directional {
+        /// Unit direction from the scene toward the light.
+        direction: DVec3,
+        /// Irradiance on a surface facing the light (W/m²).
+        irradiance: Vec3,
+    },
 }
 
 /// A whole scene.
@@ -90,7 +163,8 @@ pub struct Scene {
     pub image: ImageSettings,
     /// Camera.
     pub camera: Camera,
-    /// Radiance of rays that hit nothing (linear RGB).
+    /// Radiance arriving from infinity in every direction (linear RGB): what
+    /// rays that hit nothing see, and a uniform environment light.
     pub background: Vec3,
     /// Materials.
     pub materials: Vec<Material>,
