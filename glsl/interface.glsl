@@ -7,6 +7,8 @@
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_EXT_ray_query : require
 
+#include "common.glsl"
+
 // q(p) = pᵀAp + b·p + c with A symmetric: a0=Axx a1=Ayy a2=Azz a3=Axy a4=Ayz a5=Axz,
 // b = (b0,b1,b2), c.
 struct Quadric {
@@ -36,20 +38,6 @@ struct Cell {
     float hi[3];
     uint first;   // into the cell lists
     uint count;
-};
-
-struct Material {
-    float albedo[3];
-    float pad0;
-    float emission[3];
-    float pad1;
-};
-
-struct Light {
-    float position[3];
-    float radius;
-    float color[3];   // intensity (point) or radiance (sphere)
-    uint kind;
 };
 
 layout(set = 0, binding = BINDING_TLAS) uniform accelerationStructureEXT tlas;

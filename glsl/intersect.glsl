@@ -18,8 +18,6 @@
 // quadric's roots in each box).
 layout(constant_id = 0) const uint INTERSECT_MODE = INTERSECT_FULL;
 
-vec3 v3(float a[3]) { return vec3(a[0], a[1], a[2]); }
-
 float quadricAt(Quadric q, vec3 p) {
     return q.a[0] * p.x * p.x + q.a[1] * p.y * p.y + q.a[2] * p.z * p.z
          + 2.0 * (q.a[3] * p.x * p.y + q.a[4] * p.y * p.z + q.a[5] * p.x * p.z)

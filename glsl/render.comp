@@ -1,13 +1,15 @@
 #version 460
-// One sample per pixel of a tile: a camera ray, then direct lighting of a
-// Lambertian surface from point and sphere lights with shadow rays.
+// One sample per pixel of a tile: a path traced from the camera with
+// next-event estimation and multiple importance sampling (power heuristic)
+// at every non-specular vertex, Russian roulette after RR_DEPTH bounces, and
+// at most `maxDepth` bounces (1 = direct lighting only).
 #include "intersect.glsl"
 #include "random.glsl"
+#include "lights.glsl"
 
 layout(local_size_x = RENDER_GROUP, local_size_y = RENDER_GROUP) in;
 
 layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials { Material materials[]; };
-layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
 
 // Camera basis: ray direction = forward + x right + y up, x and y in [-1, 1].
 layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
@@ -20,6 +22,7 @@ layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
     uint height;
     uint seed;
     uint lightCount;
+    uint maxDepth;
 } frame;
 
 // rgb: summed radiance, a: sample count.
@@ -39,82 +42,102 @@ layout(push_constant, scalar) uniform Push {
     uint writeAov;
 } pc;
 
-const float PI = 3.14159265358979;
+// Bounces after which Russian roulette may end a path.
+const uint RR_DEPTH = 3u;
 
 vec3 cameraRay(vec2 pixel) {
     vec2 ndc = vec2(2.0 * pixel.x / float(frame.width) - 1.0, 1.0 - 2.0 * pixel.y / float(frame.height));
     return normalize(frame.forward + ndc.x * frame.right + ndc.y * frame.up);
 }
 
-// Offset along the normal that keeps a secondary ray off its own surface.
-vec3 offsetOrigin(vec3 p, vec3 n) {
+// Offset along the geometric normal, to the side of `dir`, that keeps a
+// secondary ray off its own surface.
+vec3 offsetOrigin(vec3 p, vec3 n, vec3 dir) {
     float scale = max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
-    return p + n * (2e-4 * scale);
+    return p + (dot(dir, n) >= 0.0 ? n : -n) * (2e-4 * scale);
 }
 
-// Distance to the first intersection with a sphere, or NO_ROOT.
-float sphereHit(vec3 o, vec3 d, vec3 c, float r) {
-    vec3 oc = o - c;
-    float b = dot(oc, d);
-    float disc = b * b - (dot(oc, oc) - r * r);
-    if (disc < 0.0) return NO_ROOT;
-    float s = sqrt(disc);
-    float t = -b - s;
-    if (t > 0.0) return t;
-    t = -b + s;
-    return t > 0.0 ? t : NO_ROOT;
-}
+bool environmentLit() { return any(greaterThan(frame.background, vec3(0.0))); }
 
-// Radiance of the sphere lights seen along a ray before distance tmax.
-vec3 visibleLights(vec3 o, vec3 d, float tmax) {
-    vec3 l = vec3(0.0);
-    float best = tmax;
-    for (uint i = 0; i < frame.lightCount; ++i) {
-        Light li = lights[i];
-        if (li.kind != LIGHT_SPHERE) continue;
-        float t = sphereHit(o, d, v3(li.position), li.radius);
-        if (t < best) { best = t; l = v3(li.color); }
+// Number of light-sampling choices: the lights, plus the environment.
+uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
+
+// Next-event estimation at a vertex with a non-delta material: one light
+// chosen uniformly. `mis` is false at the last vertex, where no BSDF-sampled
+// continuation competes.
+vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, inout uint rng) {
+    uint choices = lightChoices();
+    if (choices == 0u) return vec3(0.0);
+    uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
+    float select = 1.0 / float(choices);
+    LightSample ls = sampleLight(i, frame.lightCount, frame.background, p, rand2(rng));
+    if (!ls.valid) return vec3(0.0);
+    vec3 wiLocal = transpose(frameW) * ls.wi;
+    vec3 f = bsdfEval(mat, wo, wiLocal);
+    if (all(equal(f, vec3(0.0)))) return vec3(0.0);
+    vec3 origin = offsetOrigin(p, ng, ls.wi);
+    if (occluded(origin, ls.wi, 0.0, ls.dist)) return vec3(0.0);
+    // Area lights may hide each other: a sphere or rect light in front blocks this one.
+    if (i < frame.lightCount) {
+        float tl;
+        uint first = firstLightHit(frame.lightCount, origin, ls.wi, ls.dist * (1.0 - 1e-4), tl);
+        if (first != frame.lightCount) return vec3(0.0);
     }
-    return l;
+    vec3 contribution = f * abs(wiLocal.z) * ls.radiance / select;
+    if (ls.pdf == 0.0) return contribution;  // delta light
+    float pl = ls.pdf * select;
+    float w = mis ? powerHeuristic(pl, bsdfPdf(mat, wo, wiLocal)) : 1.0;
+    return contribution * (w / ls.pdf);
 }
 
-// Direct lighting at p with normal n (facing the viewer), Lambert BRDF.
-vec3 directLight(vec3 p, vec3 n, vec3 albedo, inout uint rng) {
-    vec3 sum = vec3(0.0);
-    vec3 origin = offsetOrigin(p, n);
-    for (uint i = 0; i < frame.lightCount; ++i) {
-        Light li = lights[i];
-        vec3 c = v3(li.position);
-        vec3 toC = c - origin;
-        float dist = length(toC);
-        if (li.kind == LIGHT_POINT) {
-            vec3 wi = toC / dist;
-            float cosT = dot(n, wi);
-            if (cosT <= 0.0 || occluded(origin, wi, 0.0, dist)) continue;
-            sum += v3(li.color) * (cosT / (dist * dist));
-        } else {
-            // Uniform sampling of the cone of directions the sphere subtends.
-            if (dist <= li.radius) continue;
-            float sinMax2 = (li.radius * li.radius) / (dist * dist);
-            float cosMax = sqrt(max(0.0, 1.0 - sinMax2));
-            vec2 u = rand2(rng);
-            float cosA = 1.0 - u.x * (1.0 - cosMax);
-            float sinA = sqrt(max(0.0, 1.0 - cosA * cosA));
-            float phi = 2.0 * PI * u.y;
-            vec3 w = toC / dist;
-            vec3 a = abs(w.x) > 0.9 ? vec3(0, 1, 0) : vec3(1, 0, 0);
-            vec3 tu = normalize(cross(a, w));
-            vec3 tv = cross(w, tu);
-            vec3 wi = normalize(cosA * w + sinA * (cos(phi) * tu + sin(phi) * tv));
-            float cosT = dot(n, wi);
-            if (cosT <= 0.0) continue;
-            float tl = sphereHit(origin, wi, c, li.radius);
-            if (tl == NO_ROOT || occluded(origin, wi, 0.0, tl)) continue;
-            float pdf = 1.0 / (2.0 * PI * (1.0 - cosMax));
-            sum += v3(li.color) * (cosT / pdf);
+vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
+    vec3 radiance = vec3(0.0);
+    vec3 throughput = vec3(1.0);
+    float lastPdf = 0.0;      // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
+    vec3 lastPoint = o;
+    uint choices = lightChoices();
+    for (uint bounce = 0u; bounce < frame.maxDepth; ++bounce) {
+        SceneHit h = traceScene(o, d, 0.0, 1e30);
+        float tl;
+        uint lightHit = firstLightHit(frame.lightCount, o, d, h.object == NO_HIT ? 1e30 : h.t, tl);
+        if (lightHit != frame.lightCount || h.object == NO_HIT) {
+            // An emitter: a sphere or rect light, or the environment.
+            uint which = lightHit != frame.lightCount ? lightHit : frame.lightCount;
+            vec3 le = which != frame.lightCount ? v3(lights[which].color) : frame.background;
+            float w = 1.0;
+            if (lastPdf > 0.0 && (which != frame.lightCount || environmentLit())) {
+                w = powerHeuristic(lastPdf, lightPdf(which, frame.lightCount, lastPoint, d) / float(choices));
+            }
+            radiance += throughput * le * w;
+            break;
+        }
+
+        Material mat = materials[objects[h.object].material];
+        vec3 p = o + h.t * d;
+        radiance += throughput * v3(mat.emission);
+        // Two-sided shading; dielectrics keep the outward normal to tell inside from outside.
+        vec3 n = mat.kind == MATERIAL_DIELECTRIC || dot(h.normal, d) < 0.0 ? h.normal : -h.normal;
+        mat3 frameW = frameAround(n);
+        vec3 wo = transpose(frameW) * -d;
+        bool last = bounce + 1u == frame.maxDepth;
+        if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, !last, rng);
+        if (last) break;
+
+        BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
+        if (!bs.valid) break;
+        throughput *= bs.weight;
+        lastPdf = bs.pdf;
+        lastPoint = p;
+        d = normalize(frameW * bs.wi);
+        o = offsetOrigin(p, h.normal, d);
+
+        if (bounce + 1u >= RR_DEPTH) {
+            float q = clamp(max(throughput.x, max(throughput.y, throughput.z)), 0.05, 0.95);
+            if (rand(rng) > q) break;
+            throughput /= q;
         }
     }
-    return sum * albedo / PI;
+    return radiance;
 }
 
 void main() {
@@ -137,22 +160,7 @@ void main() {
         aovs[idx] = aov;
     }
 
-    vec3 d = cameraRay(vec2(pix) + rand2(rng));
-    SceneHit h = traceScene(frame.eye, d, 0.0, 1e30);
-    vec3 radiance;
-    if (h.object == NO_HIT) {
-        radiance = frame.background + visibleLights(frame.eye, d, 1e30);
-    } else {
-        vec3 lightSeen = visibleLights(frame.eye, d, h.t);
-        if (lightSeen != vec3(0.0)) {
-            radiance = lightSeen;
-        } else {
-            Material m = materials[objects[h.object].material];
-            vec3 p = frame.eye + h.t * d;
-            vec3 n = dot(h.normal, d) > 0.0 ? -h.normal : h.normal;
-            radiance = v3(m.emission) + directLight(p, n, v3(m.albedo), rng);
-        }
-    }
+    vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + rand2(rng)), rng);
     // No NaN or Inf ever leaves the renderer.
     if (any(isnan(radiance)) || any(isinf(radiance))) radiance = vec3(0.0);
     ivec2 at = ivec2(pix);

@@ -35,6 +35,22 @@ pub const PROBE_GROUP: u32 = 64;
 pub const LIGHT_POINT: u32 = 0;
 /// Light kind: sphere light.
 pub const LIGHT_SPHERE: u32 = 1;
+/// Light kind: one-sided parallelogram light.
+pub const LIGHT_RECT: u32 = 2;
+/// Light kind: directional (distant) light.
+pub const LIGHT_DIRECTIONAL: u32 = 3;
+/// Material kind: Lambertian.
+pub const MATERIAL_DIFFUSE: u32 = 0;
+/// Material kind: GGX conductor.
+pub const MATERIAL_CONDUCTOR: u32 = 1;
+/// Material kind: dielectric.
+pub const MATERIAL_DIELECTRIC: u32 = 2;
+/// Material kind: perfect mirror.
+pub const MATERIAL_MIRROR: u32 = 3;
+/// Conductor Fresnel: exact, from a complex index of refraction.
+pub const FRESNEL_COMPLEX: u32 = 0;
+/// Conductor Fresnel: Schlick's approximation from f0.
+pub const FRESNEL_SCHLICK: u32 = 1;
 /// Object index written for a ray that hits nothing.
 pub const NO_HIT: u32 = 4294967295;
 /// Intersection mode: exact first root of F' (the renderer's mode).

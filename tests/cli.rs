@@ -4,8 +4,9 @@
 //! - a unit sphere seen from (0, 0, 5): the EXR's AOVs match the analytic
 //!   ray-sphere intersection of every pixel-centre ray (depth, world-space
 //!   normal, albedo; +inf, 0, 0 on a miss), the radiance is finite, equals
-//!   the background on misses, zero on the side facing away from the point
-//!   light and the Lambert value on the lit side; the PNG has the scene's
+//!   the background on misses, albedo · background (the uniform environment
+//!   seen by a convex object) on the side facing away from the point light
+//!   and that plus the Lambert value on the lit side; the PNG has the scene's
 //!   size and the tone-mapped background;
 //! - `--half` writes half-float channels, `-o NAME.exr` / `-o NAME.png` only
 //!   that file, the size flags override the scene, `QUADRAY_VALIDATION=1`
@@ -30,7 +31,7 @@ background = [0.1, 0.2, 0.3]
 [image]
 width = 40
 height = 30
-spp = 2
+spp = 25656
 seed = 3
 exposure = 1.0
 
@@ -253,6 +254,7 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     let mut max_depth_error = 0f64;
     let mut max_normal_error = 0f64;
     let mut max_lit_error = 0f64;
+    let mut max_dark_error = 0f64;
     for y in 0..HEIGHT {
         for x in 0..WIDTH {
             let i = y * WIDTH + x;
@@ -270,7 +272,8 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                     assert_eq!(albedo[i], [0.0; 3], "{at}: albedo of a miss");
                     if e.miss_distance > 1.0 + 1.5 * pixel {
                         for k in 0..3 {
-                            assert!((rgb[i][k] - BACKGROUND[k]).abs() < 1e-6, "{at}: background {:?}", rgb[i]);
+                            // f32 accumulation of 256 samples rounds at ~1e-4 relative.
+                            assert!((rgb[i][k] - BACKGROUND[k]).abs() < 2e-4, "{at}: background {:?}", rgb[i]);
                         }
                     }
                 }
@@ -286,22 +289,29 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                     for k in 0..3 {
                         assert!((albedo[i][k] - ALBEDO[k]).abs() < 1e-6, "{at}: albedo {:?}", albedo[i]);
                     }
-                    // Lambert: albedo / π · I cos θ / r², where the whole
-                    // pixel sees the sphere's front.
+                    // Lambert: albedo / π · I cos θ / r² from the point light,
+                    // where the whole pixel sees the sphere's front, plus the
+                    // uniform environment (the background), which a convex
+                    // object sees over its whole hemisphere: albedo · background.
                     let to_light = sub(LIGHT, n);
                     let r2 = dot(to_light, to_light);
                     let cos = dot(n, normalize(to_light));
+                    let environment = |k: usize| ALBEDO[k] as f64 * BACKGROUND[k] as f64;
                     if n[2] > 0.5 && cos > 0.5 {
                         lit += 1;
                         for k in 0..3 {
-                            let want = ALBEDO[k] as f64 / std::f64::consts::PI * INTENSITY * cos / r2;
+                            let want = ALBEDO[k] as f64 / std::f64::consts::PI * INTENSITY * cos / r2 + environment(k);
                             let rel = (rgb[i][k] as f64 - want).abs() / want;
                             max_lit_error = max_lit_error.max(rel);
                             assert!(rel < 0.15, "{at}: radiance {:?}, Lambert gives {want} in channel {k}", rgb[i]);
                         }
                     } else if n[2] > 0.5 && cos < -0.2 {
                         dark += 1;
-                        assert_eq!(rgb[i], [0.0; 3], "{at}: facing away from the only light");
+                        for k in 0..3 {
+                            let rel = (rgb[i][k] as f64 - environment(k)).abs() / environment(k);
+                            max_dark_error = max_dark_error.max(rel);
+                            assert!(rel < 0.25, "{at}: radiance {:?} facing away from the point light", rgb[i]);
+                        }
                     }
                 }
             }
@@ -309,8 +319,9 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     }
     println!(
         "{hits} hits ({lit} lit, {dark} dark), {misses} misses; max depth error {max_depth_error:.2e}, \
-         max normal error {max_normal_error:.2e}, max Lambert error {:.1}%",
-        100.0 * max_lit_error
+         max normal error {max_normal_error:.2e}, max Lambert error {:.1}% (lit), {:.1}% (environment only)",
+        100.0 * max_lit_error,
+        100.0 * max_dark_error
     );
     assert!(hits > 200 && misses > 200 && lit > 20 && dark > 20, "the scene should show all cases");
 

@@ -6,6 +6,11 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DAffine3, DVec3};
 
 use crate::geometry::{Perturbation, Quadric};
+use crate::scene::{ConductorFresnel, Light, Material, MaterialKind};
+use crate::shader_interface::{
+    FRESNEL_COMPLEX, FRESNEL_SCHLICK, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_RECT, LIGHT_SPHERE, MATERIAL_CONDUCTOR,
+    MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_MIRROR,
+};
 
 /// `Quadric` in interface.glsl: A's six entries, b, c.
 #[repr(C)]
@@ -81,32 +86,116 @@ pub struct GpuCell {
     pub count: u32,
 }
 
-/// `Material` in interface.glsl.
+/// `Material` in bsdf.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuMaterial {
-    /// Albedo.
+    /// `MATERIAL_*`.
+    pub kind: u32,
+    /// Diffuse albedo or mirror reflectance.
     pub albedo: [f32; 3],
-    /// Padding.
-    pub pad0: f32,
     /// Emitted radiance.
     pub emission: [f32; 3],
-    /// Padding.
-    pub pad1: f32,
+    /// Perceptual roughness (GGX α = roughness²).
+    pub roughness: f32,
+    /// Dielectric index of refraction (inside / outside).
+    pub ior: f32,
+    /// `FRESNEL_*` (conductors).
+    pub fresnel: u32,
+    /// Conductor η per RGB, or Schlick's f0.
+    pub eta: [f32; 3],
+    /// Conductor κ per RGB.
+    pub k: [f32; 3],
 }
 
-/// `Light` in interface.glsl.
+impl From<&Material> for GpuMaterial {
+    fn from(m: &Material) -> Self {
+        let mut g = GpuMaterial {
+            albedo: m.albedo.to_array(),
+            emission: m.emission.to_array(),
+            ior: 1.0,
+            ..Default::default()
+        };
+        match &m.kind {
+            MaterialKind::Diffuse => g.kind = MATERIAL_DIFFUSE,
+            MaterialKind::Mirror => g.kind = MATERIAL_MIRROR,
+            MaterialKind::Dielectric { roughness, ior } => {
+                g.kind = MATERIAL_DIELECTRIC;
+                g.roughness = *roughness;
+                g.ior = *ior;
+            }
+            MaterialKind::Conductor { roughness, fresnel } => {
+                g.kind = MATERIAL_CONDUCTOR;
+                g.roughness = *roughness;
+                match fresnel {
+                    ConductorFresnel::Complex { eta, k } => {
+                        g.fresnel = FRESNEL_COMPLEX;
+                        g.eta = eta.to_array();
+                        g.k = k.to_array();
+                    }
+                    ConductorFresnel::Schlick { f0 } => {
+                        g.fresnel = FRESNEL_SCHLICK;
+                        g.eta = f0.to_array();
+                    }
+                }
+            }
+        }
+        g
+    }
+}
+
+/// `Light` in lights.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuLight {
-    /// Position or centre.
+    /// `LIGHT_*`.
+    pub kind: u32,
+    /// Point position, sphere centre, rect corner, or the unit direction
+    /// toward a directional light.
     pub position: [f32; 3],
     /// Radius (sphere lights).
     pub radius: f32,
-    /// Intensity (point) or radiance (sphere).
+    /// Intensity (point), radiance (sphere, rect) or irradiance (directional).
     pub color: [f32; 3],
-    /// `LIGHT_POINT` or `LIGHT_SPHERE`.
-    pub kind: u32,
+    /// First edge (rect).
+    pub edge_u: [f32; 3],
+    /// Second edge (rect); the light emits toward edge_u × edge_v.
+    pub edge_v: [f32; 3],
+}
+
+impl From<&Light> for GpuLight {
+    fn from(l: &Light) -> Self {
+        let f = |v: DVec3| v.as_vec3().to_array();
+        match l {
+            Light::Point { position, intensity } => GpuLight {
+                kind: LIGHT_POINT,
+                position: f(*position),
+                color: intensity.to_array(),
+                ..Default::default()
+            },
+            Light::Sphere { centre, radius, radiance } => GpuLight {
+                kind: LIGHT_SPHERE,
+                position: f(*centre),
+                radius: *radius as f32,
+                color: radiance.to_array(),
+                ..Default::default()
+            },
+            Light::Rect { corner, edge_u, edge_v, radiance } => GpuLight {
+                kind: LIGHT_RECT,
+                position: f(*corner),
+                color: radiance.to_array(),
+                edge_u: f(*edge_u),
+                edge_v: f(*edge_v),
+                ..Default::default()
+            },
+            Light::Directional { direction, irradiance } => GpuLight {
+                kind: LIGHT_DIRECTIONAL,
+                position: f(direction.normalize()),
+                color: irradiance.to_array(),
+                ..Default::default()
+            },
+        }
+    }
 }
 
 /// `Frame` in render.comp.
@@ -131,6 +220,8 @@ pub struct GpuFrame {
     pub seed: u32,
     /// Number of lights.
     pub light_count: u32,
+    /// Longest path in bounces.
+    pub max_depth: u32,
 }
 
 /// `Aov` in render.comp.
@@ -202,9 +293,9 @@ const _: () = {
     assert!(std::mem::size_of::<GpuObject>() == 48);
     assert!(std::mem::size_of::<GpuPerturbation>() == 60);
     assert!(std::mem::size_of::<GpuCell>() == 32);
-    assert!(std::mem::size_of::<GpuMaterial>() == 32);
-    assert!(std::mem::size_of::<GpuLight>() == 32);
-    assert!(std::mem::size_of::<GpuFrame>() == 76);
+    assert!(std::mem::size_of::<GpuMaterial>() == 64);
+    assert!(std::mem::size_of::<GpuLight>() == 56);
+    assert!(std::mem::size_of::<GpuFrame>() == 80);
     assert!(std::mem::size_of::<GpuAov>() == 28);
     assert!(std::mem::size_of::<GpuRay>() == 32);
     assert!(std::mem::size_of::<GpuHit>() == 32);

@@ -57,6 +57,7 @@ pub fn render(
         height,
         seed: scene.image.seed,
         light_count: gpu.light_count,
+        max_depth: scene.image.max_depth.max(1),
     };
     let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
     let accum = Image::new(

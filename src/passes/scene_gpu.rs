@@ -8,8 +8,7 @@ use glam::{DAffine3, DVec3};
 
 use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation, GpuQuadric};
 use crate::geometry::{Aabb, CellParams};
-use crate::scene::{Light, Scene};
-use crate::shader_interface::{LIGHT_POINT, LIGHT_SPHERE};
+use crate::scene::Scene;
 use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device};
 use crate::RenderError;
 
@@ -136,31 +135,8 @@ impl GpuScene {
             .collect();
         let tlas = AccelerationStructure::top_level(device, cmds, &instances)?;
 
-        let materials: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .map(|m| GpuMaterial { albedo: m.albedo.to_array(), pad0: 0.0, emission: m.emission.to_array(), pad1: 0.0 })
-            .collect();
-        let lights: Vec<GpuLight> = scene
-            .lights
-            .iter()
-            .map(|l| match l {
-                Light::Point { position, intensity } => GpuLight {
-                    position: position.as_vec3().to_array(),
-                    radius: 0.0,
-                    color: intensity.to_array(),
-                    kind: LIGHT_POINT,
-                },
-                Light::Sphere { centre, radius, radiance } => GpuLight {
-                    position: centre.as_vec3().to_array(),
-                    radius: *radius as f32,
-                    color: radiance.to_array(),
-                    kind: LIGHT_SPHERE,
-                },
-                // Not rendered yet by render.comp (the path tracer of issue 3 adds them).
-                Light::Rect { .. } | Light::Directional { .. } => GpuLight::default(),
-            })
-            .collect();
+        let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
+        let lights: Vec<GpuLight> = scene.lights.iter().map(GpuLight::from).collect();
 
         let stats = GeometryStats {
             perturbations: perturbations.len(),

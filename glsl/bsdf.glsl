@@ -1,0 +1,228 @@
+// Surface scattering in a local frame whose +z is the shading normal. `wo`
+// points toward the viewer (or the previous path vertex), `wi` toward the next
+// vertex; both unit length. The f64 CPU twin is src/sampling/, and the GPU
+// test of the twins is tests/sampling_gpu.rs.
+#ifndef BSDF_GLSL
+#define BSDF_GLSL
+
+#include "common.glsl"
+
+const float PI = 3.14159265358979;
+// Below this GGX α a lobe is treated as a perfect specular (delta) lobe.
+const float ALPHA_DELTA = 1e-3;
+
+struct Material {
+    uint kind;          // MATERIAL_*
+    float albedo[3];    // diffuse albedo, mirror reflectance
+    float emission[3];
+    float roughness;    // conductor and dielectric; GGX α = roughness²
+    float ior;          // dielectric: n_inside / n_outside
+    uint fresnel;       // FRESNEL_COMPLEX or FRESNEL_SCHLICK (conductor)
+    float eta[3];       // conductor: η per RGB, or the Schlick f0
+    float k[3];         // conductor: κ per RGB
+};
+
+// An orthonormal basis around n (Duff et al., "Building an Orthonormal Basis,
+// Revisited", JCGT 2017).
+mat3 frameAround(vec3 n) {
+    float s = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (s + n.z);
+    float b = n.x * n.y * a;
+    vec3 t = vec3(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+    vec3 bt = vec3(b, s + n.y * n.y * a, -n.y);
+    return mat3(t, bt, n);  // columns: local x, y, z
+}
+
+vec3 sampleCosineHemisphere(vec2 u) {
+    float r = sqrt(u.x), phi = 2.0 * PI * u.y;
+    return vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));
+}
+
+vec3 sampleUniformSphere(vec2 u) {
+    float z = 1.0 - 2.0 * u.x;
+    float r = sqrt(max(0.0, 1.0 - z * z)), phi = 2.0 * PI * u.y;
+    return vec3(r * cos(phi), r * sin(phi), z);
+}
+
+// ---- GGX (Trowbridge-Reitz), isotropic ------------------------------------
+// Walter et al., "Microfacet Models for Refraction through Rough Surfaces",
+// EGSR 2007; Heitz, "Understanding the Masking-Shadowing Function in
+// Microfacet-Based BRDFs", JCGT 2014 (height-correlated G2).
+
+float ggxD(vec3 m, float a) {
+    if (m.z <= 0.0) return 0.0;
+    float a2 = a * a;
+    float t = m.z * m.z * (a2 - 1.0) + 1.0;
+    return a2 / (PI * t * t);
+}
+
+float ggxLambda(vec3 w, float a) {
+    float z2 = w.z * w.z;
+    if (z2 <= 0.0) return 1e30;
+    return 0.5 * (sqrt(1.0 + a * a * (w.x * w.x + w.y * w.y) / z2) - 1.0);
+}
+
+float ggxG1(vec3 w, float a) { return 1.0 / (1.0 + ggxLambda(w, a)); }
+float ggxG2(vec3 wo, vec3 wi, float a) { return 1.0 / (1.0 + ggxLambda(wo, a) + ggxLambda(wi, a)); }
+
+// Visible normals: E. Heitz, "Sampling the GGX Distribution of Visible
+// Normals", JCGT 2018. Requires wo.z > 0.
+vec3 ggxSampleVisibleNormal(vec3 wo, float a, vec2 u) {
+    vec3 vh = normalize(vec3(a * wo.x, a * wo.y, wo.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = lensq > 0.0 ? vec3(-vh.y, vh.x, 0.0) / sqrt(lensq) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(vh, t1);
+    float r = sqrt(u.x), phi = 2.0 * PI * u.y;
+    float p1 = r * cos(phi), p2 = r * sin(phi);
+    float s = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2;
+    vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+    return normalize(vec3(a * nh.x, a * nh.y, max(0.0, nh.z)));
+}
+
+// Density of visible normals: G1(wo) max(0, wo·m) D(m) / wo.z.
+float ggxVisiblePdf(vec3 wo, vec3 m, float a) {
+    return ggxG1(wo, a) * max(0.0, dot(wo, m)) * ggxD(m, a) / wo.z;
+}
+
+// ---- Fresnel ----------------------------------------------------------------
+
+// Unpolarised dielectric Fresnel reflectance; eta = n_inside / n_outside,
+// cosI < 0 when the incident direction is inside.
+float fresnelDielectric(float cosI, float eta) {
+    if (cosI < 0.0) {
+        eta = 1.0 / eta;
+        cosI = -cosI;
+    }
+    float sin2T = (1.0 - cosI * cosI) / (eta * eta);
+    if (sin2T >= 1.0) return 1.0;
+    float cosT = sqrt(1.0 - sin2T);
+    float rPar = (eta * cosI - cosT) / (eta * cosI + cosT);
+    float rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
+    return 0.5 * (rPar * rPar + rPerp * rPerp);
+}
+
+// Exact unpolarised Fresnel reflectance of a conductor of complex index
+// η + iκ (per channel), cosI in [0, 1].
+vec3 fresnelConductor(float cosI, vec3 eta, vec3 k) {
+    float c2 = cosI * cosI, s2 = max(0.0, 1.0 - c2);
+    vec3 e2 = eta * eta, k2 = k * k;
+    vec3 t0 = e2 - k2 - vec3(s2);
+    vec3 a2b2 = sqrt(max(t0 * t0 + 4.0 * e2 * k2, vec3(0.0)));
+    vec3 a = sqrt(max(0.5 * (a2b2 + t0), vec3(0.0)));
+    vec3 t1 = a2b2 + vec3(c2);
+    vec3 t2 = 2.0 * cosI * a;
+    vec3 rs = (t1 - t2) / max(t1 + t2, vec3(1e-30));
+    vec3 t3 = c2 * a2b2 + vec3(s2 * s2);
+    vec3 t4 = t2 * s2;
+    vec3 rp = rs * (t3 - t4) / max(t3 + t4, vec3(1e-30));
+    return clamp(0.5 * (rp + rs), 0.0, 1.0);
+}
+
+vec3 fresnelSchlick(float cosI, vec3 f0) {
+    float m = clamp(1.0 - cosI, 0.0, 1.0);
+    float m2 = m * m;
+    return f0 + (vec3(1.0) - f0) * (m2 * m2 * m);
+}
+
+vec3 conductorFresnel(Material mat, float cosI) {
+    return mat.fresnel == FRESNEL_SCHLICK ? fresnelSchlick(cosI, v3(mat.eta)) : fresnelConductor(cosI, v3(mat.eta), v3(mat.k));
+}
+
+// ---- BSDFs --------------------------------------------------------------------
+
+float materialAlpha(Material mat) { return mat.roughness * mat.roughness; }
+
+// True when the material scatters only into isolated directions (no NEE).
+bool isDelta(Material mat) {
+    if (mat.kind == MATERIAL_MIRROR || mat.kind == MATERIAL_DIELECTRIC) return true;
+    if (mat.kind == MATERIAL_CONDUCTOR) return materialAlpha(mat) < ALPHA_DELTA;
+    return false;
+}
+
+// f(wo, wi) (without the cosine) for non-delta lobes.
+vec3 bsdfEval(Material mat, vec3 wo, vec3 wi) {
+    if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
+    if (mat.kind == MATERIAL_DIFFUSE) return v3(mat.albedo) / PI;
+    if (mat.kind == MATERIAL_CONDUCTOR) {
+        float a = materialAlpha(mat);
+        vec3 m = normalize(wo + wi);
+        return conductorFresnel(mat, dot(wo, m)) * (ggxD(m, a) * ggxG2(wo, wi, a) / (4.0 * wo.z * wi.z));
+    }
+    return vec3(0.0);
+}
+
+// Solid-angle density of bsdfSample choosing wi (non-delta lobes).
+float bsdfPdf(Material mat, vec3 wo, vec3 wi) {
+    if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
+    if (mat.kind == MATERIAL_DIFFUSE) return wi.z / PI;
+    if (mat.kind == MATERIAL_CONDUCTOR) {
+        vec3 m = normalize(wo + wi);
+        return ggxVisiblePdf(wo, m, materialAlpha(mat)) / (4.0 * dot(wo, m));
+    }
+    return 0.0;
+}
+
+struct BsdfSample {
+    vec3 wi;
+    vec3 weight;   // f |cos θi| / pdf
+    float pdf;     // solid angle; 0 for a delta lobe
+    bool valid;
+};
+
+BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
+    BsdfSample s;
+    s.valid = false;
+    s.pdf = 0.0;
+    s.weight = vec3(0.0);
+    s.wi = vec3(0.0, 0.0, 1.0);
+    if (mat.kind == MATERIAL_DIELECTRIC) {
+        // Smooth dielectric (rough ones are rendered smooth for now).
+        float f = fresnelDielectric(wo.z, mat.ior);
+        if (u.z < f) {
+            s.wi = vec3(-wo.x, -wo.y, wo.z);
+            s.weight = vec3(1.0);
+        } else {
+            float etaRel = wo.z > 0.0 ? mat.ior : 1.0 / mat.ior;  // n_t / n_i
+            float cosI = abs(wo.z);
+            float cosT = sqrt(max(0.0, 1.0 - (1.0 - cosI * cosI) / (etaRel * etaRel)));
+            float side = wo.z > 0.0 ? 1.0 : -1.0;
+            s.wi = normalize(-wo / etaRel + (cosI / etaRel - cosT) * vec3(0.0, 0.0, side));
+            s.weight = vec3(1.0 / (etaRel * etaRel));
+        }
+        s.valid = true;
+        return s;
+    }
+    if (wo.z <= 0.0) return s;
+    if (mat.kind == MATERIAL_MIRROR) {
+        s.wi = vec3(-wo.x, -wo.y, wo.z);
+        s.weight = v3(mat.albedo);
+        s.valid = true;
+        return s;
+    }
+    if (mat.kind == MATERIAL_CONDUCTOR) {
+        float a = materialAlpha(mat);
+        if (a < ALPHA_DELTA) {
+            s.wi = vec3(-wo.x, -wo.y, wo.z);
+            s.weight = conductorFresnel(mat, wo.z);
+            s.valid = true;
+            return s;
+        }
+        vec3 m = ggxSampleVisibleNormal(wo, a, u.xy);
+        float om = dot(wo, m);
+        s.wi = 2.0 * om * m - wo;
+        if (s.wi.z <= 0.0 || om <= 0.0) return s;
+        s.pdf = ggxVisiblePdf(wo, m, a) / (4.0 * om);
+        s.weight = conductorFresnel(mat, om) * (ggxG2(wo, s.wi, a) / ggxG1(wo, a));
+        s.valid = s.pdf > 0.0;
+        return s;
+    }
+    // Diffuse.
+    s.wi = sampleCosineHemisphere(u.xy);
+    s.pdf = s.wi.z / PI;
+    s.weight = v3(mat.albedo);
+    s.valid = s.pdf > 0.0;
+    return s;
+}
+
+#endif

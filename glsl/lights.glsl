@@ -1,0 +1,169 @@
+// Light sampling for next-event estimation, and the densities that multiple
+// importance sampling needs when a BSDF-sampled ray finds a light
+// (Veach & Guibas, "Optimally Combining Sampling Techniques for Monte Carlo
+// Rendering", SIGGRAPH 1995; power heuristic). Light index `lightCount`
+// stands for the uniform environment (the background radiance) when it is
+// not black. The f64 CPU twin is src/sampling/.
+#ifndef LIGHTS_GLSL
+#define LIGHTS_GLSL
+
+#include "bsdf.glsl"
+
+struct Light {
+    uint kind;          // LIGHT_*
+    float position[3];  // point position, sphere centre, rect corner, directional: unit direction toward the light
+    float radius;       // sphere
+    float color[3];     // intensity (point), radiance (sphere, rect), irradiance (directional)
+    float edgeU[3];     // rect
+    float edgeV[3];     // rect; emits toward edgeU × edgeV
+};
+
+layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
+
+struct LightSample {
+    vec3 wi;
+    float dist;       // distance to the light along wi (1e30 for distant lights)
+    vec3 radiance;    // radiance, or intensity / dist² for a point light, or irradiance for a directional one
+    float pdf;        // solid-angle density; 0 for delta lights
+    bool valid;
+};
+
+float powerHeuristic(float a, float b) {
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0 ? a2 / (a2 + b2) : 0.0;
+}
+
+// Distance to the first intersection of o + t d (d unit) with a sphere, or NO_ROOT.
+float sphereHit(vec3 o, vec3 d, vec3 c, float r) {
+    vec3 oc = o - c;
+    float b = dot(oc, d);
+    float disc = b * b - (dot(oc, oc) - r * r);
+    if (disc < 0.0) return NO_ROOT;
+    float s = sqrt(disc);
+    float t = -b - s;
+    if (t > 0.0) return t;
+    t = -b + s;
+    return t > 0.0 ? t : NO_ROOT;
+}
+
+// Distance to the front (emitting) side of a rect light along o + t d, or NO_ROOT.
+float rectHit(vec3 o, vec3 d, Light l) {
+    vec3 c = v3(l.position), eu = v3(l.edgeU), ev = v3(l.edgeV);
+    vec3 n = cross(eu, ev);
+    float dn = dot(d, n);
+    if (dn >= 0.0) return NO_ROOT;  // parallel, or seeing the back
+    float t = dot(c - o, n) / dn;
+    if (t <= 0.0) return NO_ROOT;
+    vec3 q = o + t * d - c;
+    float uu = dot(eu, eu), uv = dot(eu, ev), vv = dot(ev, ev);
+    float qu = dot(q, eu), qv = dot(q, ev);
+    float det = uu * vv - uv * uv;
+    float a = (qu * vv - qv * uv) / det, b = (qv * uu - qu * uv) / det;
+    return (a >= 0.0 && a <= 1.0 && b >= 0.0 && b <= 1.0) ? t : NO_ROOT;
+}
+
+// Samples a direction toward light i (or the environment, i == lightCount)
+// from x.
+LightSample sampleLight(uint i, uint lightCount, vec3 background, vec3 x, vec2 u) {
+    LightSample s;
+    s.valid = false;
+    s.pdf = 0.0;
+    s.dist = 1e30;
+    s.radiance = vec3(0.0);
+    s.wi = vec3(0.0, 0.0, 1.0);
+    if (i == lightCount) {
+        s.wi = sampleUniformSphere(u);
+        s.radiance = background;
+        s.pdf = 1.0 / (4.0 * PI);
+        s.valid = true;
+        return s;
+    }
+    Light l = lights[i];
+    vec3 p = v3(l.position);
+    if (l.kind == LIGHT_POINT) {
+        vec3 toL = p - x;
+        s.dist = length(toL);
+        s.wi = toL / s.dist;
+        s.radiance = v3(l.color) / (s.dist * s.dist);
+        s.valid = s.dist > 0.0;
+    } else if (l.kind == LIGHT_DIRECTIONAL) {
+        s.wi = p;
+        s.radiance = v3(l.color);
+        s.valid = true;
+    } else if (l.kind == LIGHT_SPHERE) {
+        vec3 toC = p - x;
+        float d = length(toC);
+        if (d <= l.radius) return s;
+        float cosMax = sqrt(max(0.0, 1.0 - (l.radius * l.radius) / (d * d)));
+        float cosA = 1.0 - u.x * (1.0 - cosMax);
+        float sinA = sqrt(max(0.0, 1.0 - cosA * cosA));
+        float phi = 2.0 * PI * u.y;
+        vec3 w = toC / d;
+        vec3 a = abs(w.x) > 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+        vec3 tu = normalize(cross(a, w));
+        vec3 tv = cross(w, tu);
+        s.wi = normalize(cosA * w + sinA * (cos(phi) * tu + sin(phi) * tv));
+        s.dist = sphereHit(x, s.wi, p, l.radius);
+        if (s.dist == NO_ROOT) return s;
+        s.radiance = v3(l.color);
+        s.pdf = 1.0 / (2.0 * PI * (1.0 - cosMax));
+        s.valid = true;
+    } else if (l.kind == LIGHT_RECT) {
+        vec3 eu = v3(l.edgeU), ev = v3(l.edgeV);
+        vec3 nA = cross(eu, ev);
+        float area = length(nA);
+        vec3 q = p + u.x * eu + u.y * ev;
+        vec3 toQ = q - x;
+        s.dist = length(toQ);
+        s.wi = toQ / s.dist;
+        float cosL = -dot(nA / area, s.wi);
+        if (cosL <= 0.0 || s.dist <= 0.0) return s;
+        s.radiance = v3(l.color);
+        s.pdf = s.dist * s.dist / (area * cosL);
+        s.valid = true;
+    }
+    return s;
+}
+
+// Solid-angle density with which sampleLight(i) picks wi from x (area lights
+// and the environment; 0 for delta lights).
+float lightPdf(uint i, uint lightCount, vec3 x, vec3 wi) {
+    if (i == lightCount) return 1.0 / (4.0 * PI);
+    Light l = lights[i];
+    vec3 p = v3(l.position);
+    if (l.kind == LIGHT_SPHERE) {
+        vec3 toC = p - x;
+        float d2 = dot(toC, toC);
+        if (d2 <= l.radius * l.radius) return 0.0;
+        float cosMax = sqrt(max(0.0, 1.0 - (l.radius * l.radius) / d2));
+        return dot(wi, toC) >= cosMax * sqrt(d2) ? 1.0 / (2.0 * PI * (1.0 - cosMax)) : 0.0;
+    }
+    if (l.kind == LIGHT_RECT) {
+        float t = rectHit(x, wi, l);
+        if (t == NO_ROOT) return 0.0;
+        vec3 nA = cross(v3(l.edgeU), v3(l.edgeV));
+        float area = length(nA);
+        return t * t / (area * -dot(nA / area, wi));
+    }
+    return 0.0;
+}
+
+// The first area light (sphere or rect) that o + t d meets before tmax:
+// its index (or lightCount when none) and distance.
+uint firstLightHit(uint lightCount, vec3 o, vec3 d, float tmax, out float tHit) {
+    uint which = lightCount;
+    tHit = tmax;
+    for (uint i = 0; i < lightCount; ++i) {
+        Light l = lights[i];
+        float t = NO_ROOT;
+        if (l.kind == LIGHT_SPHERE) t = sphereHit(o, d, v3(l.position), l.radius);
+        else if (l.kind == LIGHT_RECT) t = rectHit(o, d, l);
+        if (t < tHit) {
+            tHit = t;
+            which = i;
+        }
+    }
+    return which;
+}
+
+#endif

@@ -1,0 +1,105 @@
+//! Furnace tests of the path tracer: scenes whose every pixel has a known
+//! value.
+//!
+//! - White furnace: diffuse objects of albedo 1 (non-convex ones among them)
+//!   under a uniform environment of radiance 1 reflect exactly 1 everywhere,
+//!   however many bounces a path takes.
+//! - Closed furnace: inside a sphere whose wall emits E and reflects with
+//!   albedo ρ, the radiance is E / (1 − ρ) everywhere (E = 0.5, ρ = 0.5: 1).
+//!
+//! Bounds, at the sample counts used: the image mean within `MEAN_TOLERANCE`
+//! of the expected value (its standard error is printed: some 10x smaller);
+//! every pixel within `PIXEL_TOLERANCE` (about 3 standard deviations of the
+//! noisiest pixels, those deep in the dents of the bumpy sphere); and the mean
+//! of every 4x4 block of pixels within `BLOCK_TOLERANCE`, so that a local bias
+//! (energy lost at silhouettes or in creases) cannot hide in the noise. No
+//! NaN or Inf.
+
+mod common;
+
+use glam::{DAffine3, DVec3, Vec3};
+use quadray::geometry::{FunctionalObject, Quadric};
+use quadray::passes::RenderOutput;
+use quadray::scene::{Material, Scene};
+
+const MEAN_TOLERANCE: f64 = 0.005;
+const PIXEL_TOLERANCE: f64 = 0.1;
+const BLOCK_TOLERANCE: f64 = 0.03;
+
+fn render(scene: &Scene) -> RenderOutput {
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let out = quadray::render_scene(&ctx, scene, &mut |_, _| {}).unwrap();
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+    out
+}
+
+/// Checks every pixel against `expected`; prints the figures.
+fn check_uniform(name: &str, out: &RenderOutput, expected: f64) {
+    let values: Vec<f64> = out.radiance.iter().flat_map(|p| p.map(|c| c as f64)).collect();
+    assert!(values.iter().all(|v| v.is_finite()), "{name}: non-finite pixel");
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let sigma = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let worst = values.iter().map(|v| (v - expected).abs()).fold(0.0, f64::max);
+    let (w, h) = (out.width as usize, out.height as usize);
+    let mut worst_block: f64 = 0.0;
+    for by in (0..h - h % 4).step_by(4) {
+        for bx in (0..w - w % 4).step_by(4) {
+            let mut sum = 0.0;
+            for y in by..by + 4 {
+                for x in bx..bx + 4 {
+                    sum += out.radiance[y * w + x].iter().map(|&c| c as f64).sum::<f64>();
+                }
+            }
+            worst_block = worst_block.max((sum / 48.0 - expected).abs());
+        }
+    }
+    println!(
+        "{name}: {w}x{h} at {} spp: mean {mean:.5} (expected {expected}, bound ±{MEAN_TOLERANCE}, standard error \
+         {:.5}); worst pixel error {worst:.4} (bound {PIXEL_TOLERANCE}); worst 4x4 block error {worst_block:.4} \
+         (bound {BLOCK_TOLERANCE})",
+        out.spp,
+        sigma / n.sqrt(),
+    );
+    assert!((mean - expected).abs() <= MEAN_TOLERANCE, "{name}: mean {mean}");
+    assert!(worst <= PIXEL_TOLERANCE, "{name}: worst pixel error {worst}");
+    assert!(worst_block <= BLOCK_TOLERANCE, "{name}: worst block error {worst_block}");
+}
+
+#[test]
+fn white_furnace_reflects_the_environment_exactly() {
+    let mut scene = common::scene_with(common::test_objects());
+    scene.materials = vec![Material::diffuse("white", Vec3::ONE)];
+    scene.lights.clear();
+    scene.background = Vec3::ONE;
+    scene.image.width = 48;
+    scene.image.height = 36;
+    scene.image.spp = 512;
+    scene.image.max_depth = 64;
+    scene.camera.position = DVec3::new(0.0, 4.0, 9.0);
+    check_uniform("white furnace", &render(&scene), 1.0);
+}
+
+#[test]
+fn closed_furnace_converges_to_emission_over_one_minus_albedo() {
+    // The camera inside a sphere of radius 5 whose wall emits 0.5 and reflects 0.5.
+    let wall = FunctionalObject {
+        base: Quadric::ellipsoid(DVec3::ZERO, DVec3::splat(5.0)),
+        perturbations: vec![],
+        clip: None,
+    };
+    let mut scene = common::scene_with(vec![common::object("room", wall, DAffine3::IDENTITY)]);
+    let mut m = Material::diffuse("wall", Vec3::splat(0.5));
+    m.emission = Vec3::splat(0.5);
+    scene.materials = vec![m];
+    scene.lights.clear();
+    scene.background = Vec3::ZERO;
+    scene.camera.position = DVec3::new(0.0, 1.0, 2.0);
+    scene.image.width = 32;
+    scene.image.height = 24;
+    scene.image.spp = 512;
+    scene.image.max_depth = 64;
+    check_uniform("closed furnace", &render(&scene), 1.0);
+}
