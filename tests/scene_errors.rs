@@ -4,7 +4,10 @@
 
 use std::path::Path;
 
-use quadray::scene::{load_scene, parse_scene, Scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+use quadray::scene::{
+    load_scene, parse_scene, ConductorFresnel, Light, MaterialKind, Scene, SceneError, DEFAULT_SCENE,
+    DEFAULT_SCENE_NAME,
+};
 
 /// A valid camera, three lines long.
 const CAMERA: &str = "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n";
@@ -166,6 +169,20 @@ fn image_settings() {
     }
     check("spp_float.toml", &format!("[image]\nspp = 2.5\n{CAMERA}"), 2, &["image.spp", "expected an integer"]);
     check("seed.toml", &format!("[image]\nseed = -1\n{CAMERA}"), 2, &["image.seed", "from 0 to 4294967295"]);
+    for depth in ["0", "65"] {
+        check(
+            &format!("max_depth_{depth}.toml"),
+            &format!("{CAMERA}[image]\nspp = 4\nmax_depth = {depth}\n"),
+            6,
+            &[":6:13:", "image.max_depth", "must be an integer from 1 to 64", &format!("(got {depth})")],
+        );
+    }
+    check(
+        "max_depth_float.toml",
+        &format!("[image]\nmax_depth = 4.0\n{CAMERA}"),
+        2,
+        &["image.max_depth", "expected an integer from 1 to 64"],
+    );
 }
 
 #[test]
@@ -286,6 +303,168 @@ fn materials() {
     );
 }
 
+/// A `[[materials]]` table named "m" after the camera; its body starts on line 6.
+fn material(body: &str) -> String {
+    format!("{CAMERA}[[materials]]\nname = \"m\"\n{body}")
+}
+
+#[test]
+fn material_keys_must_fit_the_type() {
+    check(
+        "ior_on_diffuse.toml",
+        &material("albedo = [0.5, 0.5, 0.5]\nior = 1.5\n"),
+        7,
+        &[
+            ":7:7:",
+            "materials[0].ior",
+            "`ior` does not apply to a diffuse material (the default type)",
+            "a diffuse material accepts name, type, albedo, emission",
+            "type = \"dielectric\"",
+        ],
+    );
+    check(
+        "albedo_on_conductor.toml",
+        &material("type = \"conductor\"\nalbedo = [1, 0.8, 0.3]\n"),
+        7,
+        &[
+            "materials[0].albedo",
+            "`albedo` does not apply to a conductor material",
+            "a conductor material accepts name, type, roughness, color, eta, k, metal, emission",
+        ],
+    );
+    check(
+        "albedo_on_dielectric.toml",
+        &material("type = \"dielectric\"\nior = 1.33\nalbedo = [1, 1, 1]\n"),
+        8,
+        &[
+            "materials[0].albedo",
+            "does not apply to a dielectric material",
+            "accepts name, type, ior, roughness, emission",
+        ],
+    );
+    check(
+        "roughness_on_mirror.toml",
+        &material("type = \"mirror\"\nroughness = 0.2\n"),
+        7,
+        &["materials[0].roughness", "does not apply to a mirror material", "accepts name, type, albedo, emission"],
+    );
+    check(
+        "metal_on_dielectric.toml",
+        &material("type = \"dielectric\"\nmetal = \"gold\"\n"),
+        7,
+        &["materials[0].metal", "does not apply to a dielectric material", "type = \"conductor\""],
+    );
+    // A key that belongs to no type is an unknown key.
+    check(
+        "material_typo.toml",
+        &material("type = \"conductor\"\nrougness = 0.2\n"),
+        7,
+        &["materials[0].rougness", "unknown field `rougness`", "`roughness`"],
+    );
+}
+
+#[test]
+fn material_types() {
+    check(
+        "material_type.toml",
+        &material("type = \"glass\"\n"),
+        6,
+        &[
+            ":6:8:",
+            "materials[0].type",
+            "unknown variant `glass`",
+            "expected one of `diffuse`, `conductor`, `dielectric`, `mirror`",
+        ],
+    );
+    check(
+        "metal_name.toml",
+        &material("type = \"conductor\"\nmetal = \"iron\"\n"),
+        7,
+        &["materials[0].metal", "unknown variant `iron`", "`gold`, `silver`, `copper`, `aluminium`"],
+    );
+}
+
+#[test]
+fn conductor_fresnel_forms() {
+    let m = check(
+        "two_fresnel_forms.toml",
+        &material("type = \"conductor\"\ncolor = [0.9, 0.6, 0.5]\nmetal = \"copper\"\n"),
+        8,
+        &["materials[0].metal", "one Fresnel form", "found `color` and `metal`"],
+    );
+    assert!(m.contains(":8:9:"), "{m}");
+    check(
+        "metal_and_eta.toml",
+        &material("type = \"conductor\"\nmetal = \"gold\"\neta = [0.2, 0.4, 1.4]\nk = [3.6, 2.5, 1.9]\n"),
+        8,
+        &["materials[0].eta", "found `metal` and `eta`/`k`"],
+    );
+    check(
+        "eta_without_k.toml",
+        &material("type = \"conductor\"\nroughness = 0.1\neta = [0.2, 0.4, 1.4]\n"),
+        8,
+        &["materials[0].k", "the required key `k` is missing", "`eta` and `k` together"],
+    );
+    check(
+        "k_without_eta.toml",
+        &material("type = \"conductor\"\nk = [3.6, 2.5, 1.9]\n"),
+        7,
+        &["materials[0].eta", "the required key `eta` is missing"],
+    );
+    check(
+        "eta_zero.toml",
+        &material("type = \"conductor\"\neta = [0.2, 0, 1.4]\nk = [3.6, 2.5, 1.9]\n"),
+        7,
+        &["materials[0].eta[1]", "must be positive (got 0)"],
+    );
+    check(
+        "k_negative.toml",
+        &material("type = \"conductor\"\neta = [0.2, 0.4, 1.4]\nk = [3.6, -2.5, 1.9]\n"),
+        8,
+        &["materials[0].k[1]", "must not be negative (got -2.5)"],
+    );
+    check(
+        "color_above_one.toml",
+        &material("type = \"conductor\"\ncolor = [0.9, 1.2, 0.5]\n"),
+        7,
+        &["materials[0].color[1]", "must be between 0 and 1 (got 1.2)"],
+    );
+}
+
+#[test]
+fn material_ranges() {
+    check(
+        "negative_ior.toml",
+        &material("type = \"dielectric\"\nior = -1.5\n"),
+        7,
+        &[":7:7:", "materials[0].ior", "must be positive (got -1.5)"],
+    );
+    check(
+        "zero_ior.toml",
+        &material("type = \"dielectric\"\nior = 0\n"),
+        7,
+        &["materials[0].ior", "must be positive (got 0)"],
+    );
+    check(
+        "rough_conductor.toml",
+        &material("type = \"conductor\"\nroughness = 1.5\n"),
+        7,
+        &[":7:13:", "materials[0].roughness", "must be between 0 and 1 (got 1.5)"],
+    );
+    check(
+        "rough_dielectric.toml",
+        &material("type = \"dielectric\"\nroughness = -0.1\n"),
+        7,
+        &["materials[0].roughness", "must be between 0 and 1 (got -0.1)"],
+    );
+    check(
+        "mirror_albedo.toml",
+        &material("type = \"mirror\"\nalbedo = [1, 1, 1.01]\n"),
+        7,
+        &["materials[0].albedo[2]", "must be between 0 and 1 (got 1.01)"],
+    );
+}
+
 #[test]
 fn shape_keys() {
     check(
@@ -397,7 +576,7 @@ fn lights() {
         "light_type.toml",
         &format!("{CAMERA}[[lights]]\ntype = \"spot\"\nposition = [0, 0, 0]\n"),
         5,
-        &["lights[0].type", "unknown variant `spot`"],
+        &["lights[0].type", "unknown variant `spot`", "`point`, `sphere`, `rect`, `directional`"],
     );
     check(
         "light_intensity.toml",
@@ -418,11 +597,81 @@ fn lights() {
         &["lights[0].radius", "does not apply to a point light"],
     );
     check(
+        "light_position_on_rect.toml",
+        &format!("{CAMERA}[[lights]]\ntype = \"rect\"\nposition = [0, 0, 0]\n"),
+        6,
+        &["lights[0].position", "does not apply to a rect light", "accepts type, corner, edge_u, edge_v, radiance"],
+    );
+    check(
+        "light_rect_missing.toml",
+        &format!(
+            "{CAMERA}\n[[lights]]\ntype = \"rect\"\ncorner = [0, 0, 0]\nedge_u = [1, 0, 0]\nradiance = [1, 1, 1]\n"
+        ),
+        5,
+        &["lights[0].edge_v", "the required key `edge_v` of a rect light is missing"],
+    );
+    check(
+        "light_directional_extra.toml",
+        &format!("{CAMERA}[[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nirradiance = [1, 1, 1]\nradiance = [1, 1, 1]\n"),
+        8,
+        &["lights[0].radiance", "does not apply to a directional light", "accepts type, direction, irradiance"],
+    );
+    check(
         "light_negative.toml",
         &format!("{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = [1, -1, 1]\n"),
         7,
         &["lights[0].intensity[1]", "must not be negative"],
     );
+}
+
+/// A rect light with the given edges; `edge_u` is on line 7, `edge_v` on line 8.
+fn rect(edge_u: &str, edge_v: &str) -> String {
+    format!(
+        "{CAMERA}[[lights]]\ntype = \"rect\"\ncorner = [0, 2, 0]\nedge_u = {edge_u}\nedge_v = {edge_v}\nradiance = [1, 1, 1]\n"
+    )
+}
+
+#[test]
+fn degenerate_rect_lights() {
+    check(
+        "rect_parallel.toml",
+        &rect("[1, 0, 0]", "[-3, 0, 0]"),
+        8,
+        &[":8:10:", "lights[0].edge_v", "edge_u and edge_v are parallel", "no area"],
+    );
+    check("rect_zero_u.toml", &rect("[0, 0, 0]", "[0, 0, 1]"), 7, &[":7:10:", "lights[0].edge_u", "must not be zero"]);
+    check("rect_zero_v.toml", &rect("[1, 0, 0]", "[0, 0, 0]"), 8, &["lights[0].edge_v", "must not be zero"]);
+    check("rect_nan.toml", &rect("[1, 0, 0]", "[0, 0, nan]"), 8, &["lights[0].edge_v[2]", "must be a finite number"]);
+    check(
+        "rect_radiance.toml",
+        &format!("{CAMERA}[[lights]]\ntype = \"rect\"\ncorner = [0, 2, 0]\nedge_u = [1, 0, 0]\nedge_v = [0, 0, 1]\nradiance = [1, -1, 1]\n"),
+        9,
+        &["lights[0].radiance[1]", "must not be negative"],
+    );
+    // Perpendicular and slanted edges are fine.
+    load("rect_ok.toml", &rect("[1, 0, 0]", "[0.5, 0, 1]")).unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn directional_lights() {
+    let text = |direction: &str| {
+        format!("{CAMERA}[[lights]]\ntype = \"directional\"\ndirection = {direction}\nirradiance = [3, 3, 3]\n")
+    };
+    check("sun_zero.toml", &text("[0, 0, 0]"), 6, &[":6:13:", "lights[0].direction", "must not be zero", "normalised"]);
+    check(
+        "sun_missing_irradiance.toml",
+        &format!("{CAMERA}[[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\n"),
+        4,
+        &["lights[0].irradiance", "the required key `irradiance` of a directional light is missing"],
+    );
+    check(
+        "sun_negative.toml",
+        &format!("{CAMERA}[[lights]]\ntype = \"directional\"\ndirection = [0, 1, 0]\nirradiance = [-3, 3, 3]\n"),
+        7,
+        &["lights[0].irradiance[0]", "must not be negative"],
+    );
+    let s = load("sun.toml", &text("[0, 10, 0]")).unwrap();
+    assert_eq!(s.lights, [Light::Directional { direction: glam::DVec3::Y, irradiance: glam::Vec3::splat(3.0) }]);
 }
 
 #[test]
@@ -495,6 +744,18 @@ fn every_scene_file_loads() {
     assert_eq!((s.image.width, s.image.height, s.image.spp), (64, 48, 1));
     assert_eq!(s.objects.len(), 1);
     assert_eq!(s.lights.len(), 1);
+    let s = load_scene(&root.join("tests/materials.toml")).unwrap();
+    assert_eq!(s.image.max_depth, 4);
+    let kinds: Vec<_> = s.materials.iter().map(|m| std::mem::discriminant(&m.kind)).collect();
+    for kind in [
+        MaterialKind::Diffuse,
+        MaterialKind::Mirror,
+        MaterialKind::Dielectric { roughness: 0.0, ior: 1.5 },
+        MaterialKind::Conductor { roughness: 0.3, fresnel: ConductorFresnel::Schlick { f0: glam::Vec3::ONE } },
+    ] {
+        assert!(kinds.contains(&std::mem::discriminant(&kind)), "{kind:?}");
+    }
+    assert!(matches!(s.lights[..], [Light::Rect { .. }, Light::Directional { .. }]), "{:?}", s.lights);
 }
 
 /// Every complete example (a ```toml block with a [camera]) in

@@ -11,9 +11,11 @@
 //!    span of its own token; `serde_path_to_error` records the field path on
 //!    the way, and `deny_unknown_fields` rejects misspelt keys.
 //! 2. Checks that involve more than one value (exactly one shape key per
-//!    object, material names, the camera's geometry, bounded surfaces) run on
-//!    the raw tree, which keeps `toml::Spanned` wrappers around the tables and
-//!    values those checks report on.
+//!    object, material names, keys that fit a material's or light's `type`,
+//!    a conductor's one Fresnel form, a rect light's edges, the camera's
+//!    geometry, bounded surfaces) run on the raw tree, which keeps
+//!    `toml::Spanned` wrappers around the tables and values those checks
+//!    report on.
 //!
 //! Array indices in field paths count from 0, as in `objects[0]`.
 
@@ -27,7 +29,7 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::{Camera, ImageSettings, Light, Material, MaterialKind, Scene, SceneObject};
+use super::{Camera, ConductorFresnel, ImageSettings, Light, Material, MaterialKind, Scene, SceneObject};
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 
 /// The file name used in messages about [`DEFAULT_SCENE`].
@@ -40,6 +42,10 @@ pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.toml");
 pub const MAX_IMAGE_SIZE: i64 = 16384;
 /// Largest accepted samples per pixel.
 pub const MAX_SPP: i64 = 1 << 20;
+/// Default `[image] max_depth`.
+pub const DEFAULT_MAX_DEPTH: u32 = 6;
+/// Largest accepted `[image] max_depth`.
+pub const MAX_DEPTH: i64 = 64;
 /// Largest accepted `count` of a `[[objects.scatter]]` generator.
 pub const MAX_SCATTER_COUNT: i64 = 1_000_000;
 /// Name of the built-in material given to objects without a `material` key.
@@ -292,6 +298,14 @@ number_type!(
     }
 );
 number_type!(
+    /// An index of refraction (or its real part): > 0 and small enough for f32.
+    Ior,
+    |v| {
+        require(v > 0.0, || format!("must be positive (got {v})"))?;
+        require(v <= MAX_COLOUR, || format!("must be at most {MAX_COLOUR:e} (got {v})"))
+    }
+);
+number_type!(
     /// A number in [0, 1].
     UnitInterval,
     |v| require((0.0..=1.0).contains(&v), || format!("must be between 0 and 1 (got {v})"))
@@ -319,6 +333,7 @@ struct Int<const LO: i64, const HI: i64>(i64);
 type Dimension = Int<1, MAX_IMAGE_SIZE>;
 type Samples = Int<1, MAX_SPP>;
 type Seed = Int<0, { u32::MAX as i64 }>;
+type Depth = Int<1, MAX_DEPTH>;
 type Count = Int<1, MAX_SCATTER_COUNT>;
 type Sheets = Int<1, 2>;
 
@@ -501,6 +516,7 @@ struct RawImage {
     spp: Option<Samples>,
     seed: Option<Seed>,
     exposure: Option<Exposure>,
+    max_depth: Option<Depth>,
 }
 
 #[derive(Deserialize)]
@@ -512,12 +528,85 @@ struct RawCamera {
     fov: Option<Fov>,
 }
 
+#[derive(Deserialize, Clone, Copy, PartialEq, Debug)]
+#[serde(rename_all = "lowercase")]
+enum MaterialType {
+    Diffuse,
+    Conductor,
+    Dielectric,
+    Mirror,
+}
+
+impl MaterialType {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Diffuse => "diffuse",
+            Self::Conductor => "conductor",
+            Self::Dielectric => "dielectric",
+            Self::Mirror => "mirror",
+        }
+    }
+}
+
+/// The keys each material type accepts, in the order messages list them.
+const MATERIAL_KEYS: [(&str, &[&str]); 4] = [
+    ("diffuse", &["name", "type", "albedo", "emission"]),
+    ("conductor", &["name", "type", "roughness", "color", "eta", "k", "metal", "emission"]),
+    ("dielectric", &["name", "type", "ior", "roughness", "emission"]),
+    ("mirror", &["name", "type", "albedo", "emission"]),
+];
+
+/// A named conductor whose complex index of refraction is built in.
+#[derive(Deserialize, Clone, Copy, PartialEq, Debug)]
+#[serde(rename_all = "lowercase")]
+enum Metal {
+    Gold,
+    Silver,
+    Copper,
+    #[serde(alias = "aluminum")]
+    Aluminium,
+}
+
+impl Metal {
+    /// The complex index of refraction η + iκ at 650, 550 and 450 nm (red,
+    /// green, blue), linearly interpolated between neighbouring rows of the
+    /// measured tables as published by refractiveindex.info (CC0):
+    ///
+    /// * gold, silver, copper: P. B. Johnson and R. W. Christy, "Optical
+    ///   constants of the noble metals", Phys. Rev. B 6, 4370 (1972);
+    /// * aluminium: A. D. Rakić, "Algorithm for the determination of intrinsic
+    ///   optical constants of metal films: application to aluminum", Appl.
+    ///   Opt. 34, 4755 (1995).
+    ///
+    /// These are physical constants; their normal-incidence reflectances
+    /// ((η−1)² + κ²) / ((η+1)² + κ²) are about gold (0.96, 0.79, 0.41),
+    /// silver (0.99, 0.98, 0.98), copper (0.94, 0.62, 0.54) and aluminium
+    /// (0.91, 0.92, 0.92).
+    fn ior(self) -> (Vec3, Vec3) {
+        let (eta, k) = match self {
+            Self::Gold => ([0.156, 0.424, 1.383], [3.602, 2.472, 1.915]),
+            Self::Silver => ([0.052, 0.060, 0.040], [4.409, 3.597, 2.648]),
+            Self::Copper => ([0.238, 1.007, 1.240], [3.626, 2.582, 2.393]),
+            Self::Aluminium => ([1.558, 1.015, 0.633], [7.712, 6.627, 5.454]),
+        };
+        (Vec3::from_array(eta), Vec3::from_array(k))
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a material table with a name")]
 struct RawMaterial {
     name: Spanned<String>,
-    albedo: Option<Triple<UnitInterval>>,
-    emission: Option<Triple<NonNegative>>,
+    #[serde(rename = "type")]
+    kind: Option<Spanned<MaterialType>>,
+    albedo: Option<Spanned<Triple<UnitInterval>>>,
+    emission: Option<Spanned<Triple<NonNegative>>>,
+    roughness: Option<Spanned<UnitInterval>>,
+    color: Option<Spanned<Triple<UnitInterval>>>,
+    eta: Option<Spanned<Triple<Ior>>>,
+    k: Option<Spanned<Triple<NonNegative>>>,
+    metal: Option<Spanned<Metal>>,
+    ior: Option<Spanned<Ior>>,
 }
 
 #[derive(Deserialize)]
@@ -627,17 +716,43 @@ struct RawScatter {
 enum LightKind {
     Point,
     Sphere,
+    Rect,
+    Directional,
 }
 
+impl LightKind {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Point => "point",
+            Self::Sphere => "sphere",
+            Self::Rect => "rect",
+            Self::Directional => "directional",
+        }
+    }
+}
+
+/// The keys each light type accepts, in the order messages list them.
+const LIGHT_KEYS: [(&str, &[&str]); 4] = [
+    ("point", &["type", "position", "intensity"]),
+    ("sphere", &["type", "position", "radius", "radiance"]),
+    ("rect", &["type", "corner", "edge_u", "edge_v", "radiance"]),
+    ("directional", &["type", "direction", "irradiance"]),
+];
+
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a light table with type and position")]
+#[serde(deny_unknown_fields, expecting = "a light table with a type")]
 struct RawLight {
     #[serde(rename = "type")]
     kind: LightKind,
-    position: Triple<Finite>,
+    position: Option<Spanned<Triple<Finite>>>,
     intensity: Option<Spanned<Triple<NonNegative>>>,
     radius: Option<Spanned<Positive>>,
     radiance: Option<Spanned<Triple<NonNegative>>>,
+    corner: Option<Spanned<Triple<Finite>>>,
+    edge_u: Option<Spanned<Triple<Finite>>>,
+    edge_v: Option<Spanned<Triple<Finite>>>,
+    direction: Option<Spanned<Triple<Finite>>>,
+    irradiance: Option<Spanned<Triple<NonNegative>>>,
 }
 
 // ---------------------------------------------------------------------------
@@ -652,16 +767,16 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         spp: image.and_then(|i| i.spp).map_or(16, |v| v.get() as u32),
         seed: image.and_then(|i| i.seed).map_or(0, |v| v.get() as u32),
         exposure: image.and_then(|i| i.exposure).map_or(0.0, |v| v.get() as f32),
-        max_depth: 1,
+        max_depth: image.and_then(|i| i.max_depth).map_or(DEFAULT_MAX_DEPTH, |v| v.get() as u32),
     };
     let camera = build_camera(src, &raw.camera)?;
     let background = raw.background.map_or(Vec3::ZERO, |b| b.get().as_vec3());
 
     let mut materials: Vec<Material> = Vec::with_capacity(raw.materials.len() + 1);
     let mut material_lines = Vec::with_capacity(raw.materials.len());
-    for (i, m) in raw.materials.iter().enumerate() {
-        let span = m.span();
-        let m = m.get_ref();
+    for (i, raw_material) in raw.materials.iter().enumerate() {
+        let span = raw_material.span();
+        let m = raw_material.get_ref();
         let name = m.name.get_ref();
         if name.is_empty() {
             return Err(src.error(Some(m.name.span()), format!("materials[{i}].name"), "must not be empty"));
@@ -675,12 +790,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
             ));
         }
         material_lines.push(src.text[..span.start.min(src.text.len())].matches('\n').count() + 1);
-        materials.push(Material {
-            name: name.clone(),
-            kind: MaterialKind::Diffuse,
-            albedo: m.albedo.map_or(Vec3::splat(0.8), |a| a.get().as_vec3()),
-            emission: m.emission.map_or(Vec3::ZERO, |e| e.get().as_vec3()),
-        });
+        materials.push(build_material(src, i, raw_material)?);
     }
     let user_materials = materials.len();
 
@@ -956,41 +1066,234 @@ fn geometry_error(
     }
 }
 
-fn build_light(src: &Source, i: usize, raw: &Spanned<RawLight>) -> Result<Light, SceneError> {
-    let l = raw.get_ref();
-    let position = l.position.get();
-    let unexpected = |key: &str, span: Range<usize>, kind: &str| {
-        src.error(Some(span), format!("lights[{i}].{key}"), format!("`{key}` does not apply to a {kind} light"))
+/// The span of an optional spanned value.
+fn span_of<T>(value: &Option<Spanned<T>>) -> Option<Range<usize>> {
+    value.as_ref().map(Spanned::span)
+}
+
+/// Rejects keys that do not apply to the table's type. `table` is the field
+/// path of the table (`materials[2]`), `noun` what it is (`material`),
+/// `types` the keys each type accepts, `kind` the table's type, `defaulted`
+/// whether that type was not written, and `present` the optional keys given,
+/// with the spans of their values.
+fn check_type_keys(
+    src: &Source,
+    table: &str,
+    noun: &str,
+    types: &[(&str, &[&str])],
+    kind: &str,
+    defaulted: bool,
+    present: &[(&str, Option<Range<usize>>)],
+) -> Result<(), SceneError> {
+    let accepted = types.iter().find(|(t, _)| *t == kind).map_or(&[][..], |(_, keys)| *keys);
+    let first_bad = present
+        .iter()
+        .filter_map(|(key, span)| span.clone().map(|s| (*key, s)))
+        .filter(|(key, _)| !accepted.contains(key))
+        .min_by_key(|(_, span)| span.start);
+    let Some((key, span)) = first_bad else { return Ok(()) };
+    let owners: Vec<String> =
+        types.iter().filter(|(_, keys)| keys.contains(&key)).map(|(t, _)| format!("type = {t:?}")).collect();
+    let default_note = if defaulted { " (the default type)" } else { "" };
+    Err(src.error(
+        Some(span),
+        format!("{table}.{key}"),
+        format!(
+            "`{key}` does not apply to a {kind} {noun}{default_note}; a {kind} {noun} accepts {}. `{key}` belongs to {}",
+            accepted.join(", "),
+            owners.join(" or "),
+        ),
+    ))
+}
+
+fn build_material(src: &Source, i: usize, raw: &Spanned<RawMaterial>) -> Result<Material, SceneError> {
+    let m = raw.get_ref();
+    let table = format!("materials[{i}]");
+    let kind = m.kind.as_ref().map_or(MaterialType::Diffuse, |t| *t.get_ref());
+    check_type_keys(
+        src,
+        &table,
+        "material",
+        &MATERIAL_KEYS,
+        kind.name(),
+        m.kind.is_none(),
+        &[
+            ("albedo", span_of(&m.albedo)),
+            ("emission", span_of(&m.emission)),
+            ("roughness", span_of(&m.roughness)),
+            ("color", span_of(&m.color)),
+            ("eta", span_of(&m.eta)),
+            ("k", span_of(&m.k)),
+            ("metal", span_of(&m.metal)),
+            ("ior", span_of(&m.ior)),
+        ],
+    )?;
+    let albedo = |default: f32| m.albedo.as_ref().map_or(Vec3::splat(default), |a| a.get_ref().get().as_vec3());
+    let roughness = |default: f32| m.roughness.as_ref().map_or(default, |r| r.get_ref().get() as f32);
+    // Conductors and dielectrics have no albedo; theirs is a neutral 1.
+    let (kind, albedo) = match kind {
+        MaterialType::Diffuse => (MaterialKind::Diffuse, albedo(0.8)),
+        MaterialType::Mirror => (MaterialKind::Mirror, albedo(1.0)),
+        MaterialType::Conductor => (
+            MaterialKind::Conductor { roughness: roughness(0.3), fresnel: conductor_fresnel(src, &table, raw)? },
+            Vec3::ONE,
+        ),
+        MaterialType::Dielectric => (
+            MaterialKind::Dielectric {
+                roughness: roughness(0.0),
+                ior: m.ior.as_ref().map_or(1.5, |v| v.get_ref().get() as f32),
+            },
+            Vec3::ONE,
+        ),
     };
-    let missing = |key: &str, kind: &str| {
+    Ok(Material {
+        name: m.name.get_ref().clone(),
+        kind,
+        albedo,
+        emission: m.emission.as_ref().map_or(Vec3::ZERO, |e| e.get_ref().get().as_vec3()),
+    })
+}
+
+/// The Fresnel term of a conductor from its one of `color`, `eta` with `k`,
+/// and `metal` (Schlick with 0.9 grey when none is given).
+fn conductor_fresnel(src: &Source, table: &str, raw: &Spanned<RawMaterial>) -> Result<ConductorFresnel, SceneError> {
+    let m = raw.get_ref();
+    // The forms given, in source order: (key for the field path, its description, span).
+    let complex_key = match (span_of(&m.eta), span_of(&m.k)) {
+        (Some(e), Some(k)) if k.start < e.start => Some(("k", k)),
+        (Some(e), _) => Some(("eta", e)),
+        (None, k) => k.map(|k| ("k", k)),
+    };
+    let mut forms: Vec<(&str, &str, Range<usize>)> = [
+        span_of(&m.color).map(|s| ("color", "`color`", s)),
+        complex_key.map(|(key, s)| (key, "`eta`/`k`", s)),
+        span_of(&m.metal).map(|s| ("metal", "`metal`", s)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    forms.sort_by_key(|(_, _, span)| span.start);
+    if let [first, second, ..] = forms.as_slice() {
+        return Err(src.error(
+            Some(second.2.clone()),
+            format!("{table}.{}", second.0),
+            format!(
+                "a conductor takes one Fresnel form: `color` (Schlick), `eta` with `k` (complex index of \
+                 refraction) or `metal` (a named metal); found {} and {}",
+                first.1, second.1
+            ),
+        ));
+    }
+    let pair_missing = |missing: &str, given: &str, span: Range<usize>| {
         src.error(
-            Some(raw.span()),
-            format!("lights[{i}].{key}"),
-            format!("the required key `{key}` of a {kind} light is missing"),
+            Some(span),
+            format!("{table}.{missing}"),
+            format!(
+                "the required key `{missing}` is missing: `{given}` needs it (`eta` and `k` together give the \
+                 complex index of refraction η + iκ)"
+            ),
         )
     };
-    match l.kind {
-        LightKind::Point => {
-            if let Some(r) = &l.radius {
-                return Err(unexpected("radius", r.span(), "point"));
-            }
-            if let Some(r) = &l.radiance {
-                return Err(unexpected("radiance", r.span(), "point (use `intensity`)"));
-            }
-            let intensity = l.intensity.as_ref().ok_or_else(|| missing("intensity", "point"))?;
-            Ok(Light::Point { position, intensity: intensity.get_ref().get().as_vec3() })
+    Ok(match (&m.color, &m.eta, &m.k, &m.metal) {
+        (Some(c), ..) => ConductorFresnel::Schlick { f0: c.get_ref().get().as_vec3() },
+        (_, Some(eta), Some(k), _) => {
+            ConductorFresnel::Complex { eta: eta.get_ref().get().as_vec3(), k: k.get_ref().get().as_vec3() }
         }
+        (_, Some(eta), None, _) => return Err(pair_missing("k", "eta", eta.span())),
+        (_, None, Some(k), _) => return Err(pair_missing("eta", "k", k.span())),
+        (.., Some(metal)) => {
+            let (eta, k) = metal.get_ref().ior();
+            ConductorFresnel::Complex { eta, k }
+        }
+        _ => ConductorFresnel::Schlick { f0: Vec3::splat(0.9) },
+    })
+}
+
+fn build_light(src: &Source, i: usize, raw: &Spanned<RawLight>) -> Result<Light, SceneError> {
+    let l = raw.get_ref();
+    let table = format!("lights[{i}]");
+    let kind = l.kind.name();
+    check_type_keys(
+        src,
+        &table,
+        "light",
+        &LIGHT_KEYS,
+        kind,
+        false,
+        &[
+            ("position", span_of(&l.position)),
+            ("intensity", span_of(&l.intensity)),
+            ("radius", span_of(&l.radius)),
+            ("radiance", span_of(&l.radiance)),
+            ("corner", span_of(&l.corner)),
+            ("edge_u", span_of(&l.edge_u)),
+            ("edge_v", span_of(&l.edge_v)),
+            ("direction", span_of(&l.direction)),
+            ("irradiance", span_of(&l.irradiance)),
+        ],
+    )?;
+    fn required<'a, T>(
+        src: &Source,
+        table: &str,
+        kind: &str,
+        raw: &Spanned<RawLight>,
+        key: &str,
+        value: &'a Option<Spanned<T>>,
+    ) -> Result<&'a Spanned<T>, SceneError> {
+        value.as_ref().ok_or_else(|| {
+            src.error(
+                Some(raw.span()),
+                format!("{table}.{key}"),
+                format!("the required key `{key}` of a {kind} light is missing"),
+            )
+        })
+    }
+    let vector = |key: &str, value: &Option<Spanned<Triple<Finite>>>| {
+        required(src, &table, kind, raw, key, value).map(|v| (v.get_ref().get(), v.span()))
+    };
+    let colour = |key: &str, value: &Option<Spanned<Triple<NonNegative>>>| {
+        required(src, &table, kind, raw, key, value).map(|v| v.get_ref().get().as_vec3())
+    };
+    match l.kind {
+        LightKind::Point => Ok(Light::Point {
+            position: vector("position", &l.position)?.0,
+            intensity: colour("intensity", &l.intensity)?,
+        }),
         LightKind::Sphere => {
-            if let Some(r) = &l.intensity {
-                return Err(unexpected("intensity", r.span(), "sphere (use `radiance`)"));
+            let centre = vector("position", &l.position)?.0;
+            let radius = required(src, &table, kind, raw, "radius", &l.radius)?.get_ref().get();
+            Ok(Light::Sphere { centre, radius, radiance: colour("radiance", &l.radiance)? })
+        }
+        LightKind::Rect => {
+            let corner = vector("corner", &l.corner)?.0;
+            let (edge_u, u_span) = vector("edge_u", &l.edge_u)?;
+            let (edge_v, v_span) = vector("edge_v", &l.edge_v)?;
+            let radiance = colour("radiance", &l.radiance)?;
+            for (key, edge, span) in [("edge_u", edge_u, &u_span), ("edge_v", edge_v, &v_span)] {
+                if edge.length() == 0.0 {
+                    return Err(src.error(Some(span.clone()), format!("{table}.{key}"), "must not be zero"));
+                }
             }
-            let radius = l.radius.as_ref().ok_or_else(|| missing("radius", "sphere"))?;
-            let radiance = l.radiance.as_ref().ok_or_else(|| missing("radiance", "sphere"))?;
-            Ok(Light::Sphere {
-                centre: position,
-                radius: radius.get_ref().get(),
-                radiance: radiance.get_ref().get().as_vec3(),
-            })
+            if edge_u.cross(edge_v).length() <= 1e-6 * edge_u.length() * edge_v.length() {
+                return Err(src.error(
+                    Some(v_span),
+                    format!("{table}.edge_v"),
+                    "edge_u and edge_v are parallel, so the rect light has no area; \
+                     give two edges that span a parallelogram",
+                ));
+            }
+            Ok(Light::Rect { corner, edge_u, edge_v, radiance })
+        }
+        LightKind::Directional => {
+            let (direction, span) = vector("direction", &l.direction)?;
+            let Some(direction) = direction.try_normalize() else {
+                return Err(src.error(
+                    Some(span),
+                    format!("{table}.direction"),
+                    "must not be zero (it points from the scene toward the light and is normalised on load)",
+                ));
+            };
+            Ok(Light::Directional { direction, irradiance: colour("irradiance", &l.irradiance)? })
         }
     }
 }
@@ -1071,7 +1374,7 @@ mod tests {
     #[test]
     fn defaults() {
         let s = parse("");
-        assert_eq!(s.image, ImageSettings { width: 640, height: 480, spp: 16, seed: 0, exposure: 0.0, max_depth: 1 });
+        assert_eq!(s.image, ImageSettings { width: 640, height: 480, spp: 16, seed: 0, exposure: 0.0, max_depth: 6 });
         assert_eq!(s.camera.up, DVec3::Y);
         assert_eq!(s.camera.vfov_degrees, 40.0);
         assert_eq!(s.background, Vec3::ZERO);
@@ -1080,11 +1383,11 @@ mod tests {
 
     #[test]
     fn image_and_background() {
-        let text = "background = [0.1, 0.2, 0.3]\n[image]\nwidth = 64\nheight = 48\nspp = 3\nseed = 4000000000\nexposure = -1.5\n";
+        let text = "background = [0.1, 0.2, 0.3]\n[image]\nwidth = 64\nheight = 48\nspp = 3\nseed = 4000000000\nexposure = -1.5\nmax_depth = 12\n";
         let s = parse_scene(&format!("{text}{CAMERA}"), "t.toml").unwrap();
         assert_eq!(
             s.image,
-            ImageSettings { width: 64, height: 48, spp: 3, seed: 4_000_000_000, exposure: -1.5, max_depth: 1 }
+            ImageSettings { width: 64, height: 48, spp: 3, seed: 4_000_000_000, exposure: -1.5, max_depth: 12 }
         );
         assert_eq!(s.background, Vec3::new(0.1, 0.2, 0.3));
     }
@@ -1260,6 +1563,196 @@ mod tests {
                 Light::Sphere { centre: DVec3::new(0.0, 5.0, 0.0), radius: 0.5, radiance: Vec3::new(4.0, 3.0, 2.0) },
             ]
         );
+    }
+
+    #[test]
+    fn max_depth_range() {
+        for depth in [1, 64] {
+            let s = parse_scene(&format!("[image]\nmax_depth = {depth}\n{CAMERA}"), "t.toml").unwrap();
+            assert_eq!(s.image.max_depth, depth);
+        }
+        for depth in ["0", "65", "-1", "2.5"] {
+            let e = parse_scene(&format!("[image]\nmax_depth = {depth}\n{CAMERA}"), "t.toml").unwrap_err();
+            let SceneError::Invalid { line, ref field, .. } = e else { panic!("{e}") };
+            assert_eq!((line, field.as_str()), (2, "image.max_depth"), "{e}");
+        }
+    }
+
+    fn one_material(body: &str) -> Material {
+        let s = parse(&format!("[[materials]]\nname = \"m\"\n{body}"));
+        s.materials.into_iter().next().unwrap()
+    }
+
+    fn material_error(body: &str) -> String {
+        let text = format!("{CAMERA}[[materials]]\nname = \"m\"\n{body}");
+        parse_scene(&text, "t.toml").map(|_| ()).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn material_types_and_defaults() {
+        let d = one_material("");
+        assert_eq!(d, Material::diffuse("m", Vec3::splat(0.8)));
+        assert_eq!(one_material("type = \"diffuse\"\nalbedo = [0.1, 0.2, 0.3]").albedo, Vec3::new(0.1, 0.2, 0.3));
+
+        let m = one_material("type = \"mirror\"");
+        assert_eq!((m.kind, m.albedo, m.emission), (MaterialKind::Mirror, Vec3::ONE, Vec3::ZERO));
+        assert_eq!(one_material("type = \"mirror\"\nalbedo = [0.9, 0.8, 0.7]").albedo, Vec3::new(0.9, 0.8, 0.7));
+
+        let c = one_material("type = \"conductor\"");
+        assert_eq!(
+            c.kind,
+            MaterialKind::Conductor { roughness: 0.3, fresnel: ConductorFresnel::Schlick { f0: Vec3::splat(0.9) } }
+        );
+        assert_eq!(c.albedo, Vec3::ONE);
+        let c = one_material("type = \"conductor\"\nroughness = 0\nemission = [1, 2, 3]");
+        assert!(matches!(c.kind, MaterialKind::Conductor { roughness: 0.0, .. }));
+        assert_eq!(c.emission, Vec3::new(1.0, 2.0, 3.0));
+
+        let g = one_material("type = \"dielectric\"");
+        assert_eq!((g.kind, g.albedo), (MaterialKind::Dielectric { roughness: 0.0, ior: 1.5 }, Vec3::ONE));
+        let w = one_material("type = \"dielectric\"\nior = 1.33\nroughness = 0.25");
+        assert_eq!(w.kind, MaterialKind::Dielectric { roughness: 0.25, ior: 1.33 });
+
+        // Emission on every type.
+        for ty in ["diffuse", "conductor", "dielectric", "mirror"] {
+            let m = one_material(&format!("type = \"{ty}\"\nemission = [4, 5, 6]"));
+            assert_eq!(m.emission, Vec3::new(4.0, 5.0, 6.0), "{ty}");
+        }
+    }
+
+    #[test]
+    fn conductor_fresnel_forms() {
+        let fresnel = |body: &str| match one_material(&format!("type = \"conductor\"\n{body}")).kind {
+            MaterialKind::Conductor { fresnel, .. } => fresnel,
+            k => panic!("{k:?}"),
+        };
+        assert_eq!(
+            fresnel("color = [0.95, 0.64, 0.54]"),
+            ConductorFresnel::Schlick { f0: Vec3::new(0.95, 0.64, 0.54) }
+        );
+        assert_eq!(
+            fresnel("eta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.2]"),
+            ConductorFresnel::Complex { eta: Vec3::new(0.2, 0.9, 1.1), k: Vec3::new(3.9, 2.4, 2.2) }
+        );
+        // k = 0 is allowed (a non-absorbing "conductor").
+        assert_eq!(
+            fresnel("k = [0, 0, 0]\neta = [1.5, 1.5, 1.5]"),
+            ConductorFresnel::Complex { eta: Vec3::splat(1.5), k: Vec3::ZERO }
+        );
+        assert_eq!(fresnel("metal = \"aluminum\""), fresnel("metal = \"aluminium\""));
+    }
+
+    #[test]
+    fn named_metals_are_complex_iors() {
+        /// Reflectance at normal incidence of a conductor in vacuum.
+        fn f0(eta: Vec3, k: Vec3) -> Vec3 {
+            ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k)
+        }
+        let mut seen = Vec::new();
+        for (metal, preset) in [
+            ("gold", Metal::Gold),
+            ("silver", Metal::Silver),
+            ("copper", Metal::Copper),
+            ("aluminium", Metal::Aluminium),
+        ] {
+            let m = one_material(&format!("type = \"conductor\"\nmetal = \"{metal}\"\nroughness = 0.1"));
+            let MaterialKind::Conductor { roughness, fresnel: ConductorFresnel::Complex { eta, k } } = m.kind else {
+                panic!("{metal}: {:?}", m.kind)
+            };
+            assert_eq!(roughness, 0.1);
+            assert_eq!((eta, k), preset.ior(), "{metal}");
+            assert!(eta.min_element() > 0.0 && k.min_element() > 0.0, "{metal}");
+            let r = f0(eta, k);
+            assert!(r.min_element() > 0.3 && r.max_element() < 1.0, "{metal}: {r}");
+            seen.push(r);
+        }
+        // Gold and copper are red-yellow: reflectance falls from red to blue;
+        // silver and aluminium are nearly neutral and bright.
+        for r in &seen[..1] {
+            assert!(r.x > r.y && r.y > r.z, "{r}");
+        }
+        assert!(seen[2].x > seen[2].y && seen[2].x > seen[2].z, "copper {}", seen[2]);
+        for r in [seen[1], seen[3]] {
+            assert!(r.min_element() > 0.85 && r.max_element() - r.min_element() < 0.05, "{r}");
+        }
+    }
+
+    #[test]
+    fn material_key_errors() {
+        let e = material_error("ior = 1.5\n");
+        assert!(
+            e.starts_with(
+                "t.toml:6:7: materials[0].ior: `ior` does not apply to a diffuse material (the default type)"
+            ),
+            "{e}"
+        );
+        assert!(e.contains("accepts name, type, albedo, emission") && e.contains("type = \"dielectric\""), "{e}");
+        let e = material_error("type = \"conductor\"\nalbedo = [1, 1, 1]\n");
+        assert!(e.contains("materials[0].albedo: `albedo` does not apply to a conductor material;"), "{e}");
+        assert!(e.contains("type = \"diffuse\" or type = \"mirror\""), "{e}");
+        let e = material_error("type = \"glass\"\n");
+        assert!(e.contains("materials[0].type") && e.contains("`dielectric`"), "{e}");
+        let e = material_error("type = \"conductor\"\nmetal = \"gold\"\ncolor = [1, 1, 1]\n");
+        assert!(e.starts_with("t.toml:8:9: materials[0].color:") && e.contains("found `metal` and `color`"), "{e}");
+        let e = material_error("type = \"conductor\"\neta = [1, 1, 1]\n");
+        assert!(e.starts_with("t.toml:7:7: materials[0].k: the required key `k` is missing"), "{e}");
+        let e = material_error("type = \"conductor\"\nk = [1, 1, 1]\n");
+        assert!(e.contains("materials[0].eta: the required key `eta` is missing"), "{e}");
+        let e = material_error("type = \"conductor\"\nmetal = \"iron\"\n");
+        assert!(e.contains("materials[0].metal") && e.contains("unknown variant `iron`"), "{e}");
+        let e = material_error("type = \"dielectric\"\nior = 0\n");
+        assert!(e.contains("materials[0].ior: must be positive (got 0)"), "{e}");
+        let e = material_error("type = \"conductor\"\neta = [1, 0, 1]\nk = [1, 1, 1]\n");
+        assert!(e.contains("materials[0].eta[1]: must be positive (got 0)"), "{e}");
+    }
+
+    #[test]
+    fn rect_and_directional_lights() {
+        let s = parse(
+            "[[lights]]\ntype = \"rect\"\ncorner = [-1, 2, -1]\nedge_u = [2, 0, 0]\nedge_v = [0, 0, 2]\nradiance = [5, 4, 3]\n\
+             [[lights]]\ntype = \"directional\"\ndirection = [0, 3, 4]\nirradiance = [2, 2, 2]\n",
+        );
+        assert_eq!(
+            s.lights[0],
+            Light::Rect {
+                corner: DVec3::new(-1.0, 2.0, -1.0),
+                edge_u: DVec3::new(2.0, 0.0, 0.0),
+                edge_v: DVec3::new(0.0, 0.0, 2.0),
+                radiance: Vec3::new(5.0, 4.0, 3.0),
+            }
+        );
+        let Light::Directional { direction, irradiance } = s.lights[1] else { panic!("{:?}", s.lights[1]) };
+        assert!((direction - DVec3::new(0.0, 0.6, 0.8)).length() < 1e-12, "normalised: {direction}");
+        assert_eq!(irradiance, Vec3::splat(2.0));
+        // The documented example emits downward.
+        let Light::Rect { edge_u, edge_v, .. } = s.lights[0] else { unreachable!() };
+        assert_eq!(edge_u.cross(edge_v), DVec3::new(0.0, -4.0, 0.0));
+    }
+
+    #[test]
+    fn light_errors() {
+        let err = |body: &str| parse_scene(&format!("{CAMERA}[[lights]]\n{body}"), "t.toml").unwrap_err().to_string();
+        let rect = |u: &str, v: &str| {
+            err(&format!("type = \"rect\"\ncorner = [0, 0, 0]\nedge_u = {u}\nedge_v = {v}\nradiance = [1, 1, 1]\n"))
+        };
+        let e = rect("[1, 0, 0]", "[-2, 0, 0]");
+        assert!(e.starts_with("t.toml:8:10: lights[0].edge_v: edge_u and edge_v are parallel"), "{e}");
+        let e = rect("[0, 0, 0]", "[0, 0, 1]");
+        assert!(e.starts_with("t.toml:7:10: lights[0].edge_u: must not be zero"), "{e}");
+        let e = rect("[1, 0, 0]", "[0, 0, 0]");
+        assert!(e.starts_with("t.toml:8:10: lights[0].edge_v: must not be zero"), "{e}");
+        let e = err("type = \"directional\"\ndirection = [0, 0, 0]\nirradiance = [1, 1, 1]\n");
+        assert!(e.starts_with("t.toml:6:13: lights[0].direction: must not be zero"), "{e}");
+        let e = err("type = \"rect\"\nposition = [0, 0, 0]\n");
+        assert!(e.contains("lights[0].position: `position` does not apply to a rect light;"), "{e}");
+        assert!(e.contains("accepts type, corner, edge_u, edge_v, radiance"), "{e}");
+        let e = err("type = \"directional\"\ndirection = [0, 1, 0]\n");
+        assert!(
+            e.starts_with("t.toml:4:1: lights[0].irradiance: the required key `irradiance` of a directional"),
+            "{e}"
+        );
+        let e = err("type = \"sphere\"\nradius = 1\nradiance = [1, 1, 1]\n");
+        assert!(e.contains("lights[0].position: the required key `position` of a sphere light is missing"), "{e}");
     }
 
     #[test]

@@ -18,8 +18,10 @@ pub struct Image {
     allocation: Option<Allocation>,
     /// Pixel format.
     pub format: vk::Format,
-    /// Size in pixels.
+    /// Size in pixels of level 0.
     pub extent: vk::Extent2D,
+    /// Number of mip levels.
+    pub levels: u32,
 }
 
 impl Image {
@@ -31,11 +33,23 @@ impl Image {
         format: vk::Format,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, VkError> {
+        Self::with_levels(device, name, extent, 1, format, usage)
+    }
+
+    /// Creates a device-local image with `levels` mip levels, in layout UNDEFINED.
+    pub fn with_levels(
+        device: &Arc<Device>,
+        name: &str,
+        extent: vk::Extent2D,
+        levels: u32,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self, VkError> {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
             .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
-            .mip_levels(1)
+            .mip_levels(levels)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -44,7 +58,7 @@ impl Image {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let raw = unsafe { device.raw.create_image(&info, None) }?;
         let mut this =
-            Self { device: device.clone(), raw, view: vk::ImageView::null(), allocation: None, format, extent };
+            Self { device: device.clone(), raw, view: vk::ImageView::null(), allocation: None, format, extent, levels };
         let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
         let allocation = device
             .allocator
@@ -64,13 +78,51 @@ impl Image {
             .image(raw)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
-            .subresource_range(Self::whole());
+            .subresource_range(this.all_levels());
         this.view = unsafe { device.raw.create_image_view(&view_info, None) }?;
         Ok(this)
     }
 
-    fn whole() -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1)
+    fn all_levels(&self) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange::default()
+            .aspect_mask(vk::ImageAspectFlags::COLOR)
+            .level_count(self.levels)
+            .layer_count(1)
+    }
+
+    /// Records copying `buffer` into every mip level (tightly packed, level
+    /// after level, starting at byte 0) and leaves the image in
+    /// SHADER_READ_ONLY_OPTIMAL. `texel_bytes` is the size of one texel.
+    pub fn upload_levels(&self, cmd: vk::CommandBuffer, buffer: &Buffer, texel_bytes: u64) {
+        self.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+        let mut offset = 0u64;
+        let regions: Vec<vk::BufferImageCopy> = (0..self.levels)
+            .map(|level| {
+                let w = (self.extent.width >> level).max(1);
+                let h = (self.extent.height >> level).max(1);
+                let region = vk::BufferImageCopy::default()
+                    .buffer_offset(offset)
+                    .image_subresource(
+                        vk::ImageSubresourceLayers::default()
+                            .aspect_mask(vk::ImageAspectFlags::COLOR)
+                            .mip_level(level)
+                            .layer_count(1),
+                    )
+                    .image_extent(vk::Extent3D { width: w, height: h, depth: 1 });
+                offset += w as u64 * h as u64 * texel_bytes;
+                region
+            })
+            .collect();
+        unsafe {
+            self.device.raw.cmd_copy_buffer_to_image(
+                cmd,
+                buffer.raw,
+                self.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &regions,
+            )
+        };
+        self.transition(cmd, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
     }
 
     /// Records a transition from `from` to `to`, making all earlier
@@ -88,7 +140,7 @@ impl Image {
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(self.raw)
-            .subresource_range(Self::whole());
+            .subresource_range(self.all_levels());
         let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
         unsafe {
             self.device.raw.cmd_pipeline_barrier(
@@ -107,7 +159,7 @@ impl Image {
     pub fn clear(&self, cmd: vk::CommandBuffer) {
         let zero = vk::ClearColorValue { float32: [0.0; 4] };
         unsafe {
-            self.device.raw.cmd_clear_color_image(cmd, self.raw, vk::ImageLayout::GENERAL, &zero, &[Self::whole()])
+            self.device.raw.cmd_clear_color_image(cmd, self.raw, vk::ImageLayout::GENERAL, &zero, &[self.all_levels()])
         };
     }
 

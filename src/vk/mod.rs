@@ -10,6 +10,7 @@ mod device;
 mod image;
 mod instance;
 mod pipeline;
+mod sampler;
 mod timestamps;
 
 use std::sync::Arc;
@@ -23,6 +24,7 @@ pub use gpu_allocator::MemoryLocation;
 pub use image::Image;
 pub use instance::{Instance, ValidationCounters};
 pub use pipeline::{Binding, BindingKind, ComputePipeline};
+pub use sampler::Sampler;
 pub use timestamps::Timestamps;
 
 /// Errors from the Vulkan backend.
