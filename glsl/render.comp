@@ -70,12 +70,15 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, in
     if (choices == 0u) return vec3(0.0);
     uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
     float select = 1.0 / float(choices);
-    LightSample ls = sampleLight(i, frame.lightCount, frame.background, p, rand2(rng));
+    // Sample from the shadow ray's origin (offset off the surface on the side
+    // of the shading normal, the only side a non-delta material reflects to),
+    // so that the light's distance is measured from where the ray starts.
+    vec3 origin = offsetOrigin(p, ng, frameW[2]);
+    LightSample ls = sampleLight(i, frame.lightCount, frame.background, origin, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     vec3 wiLocal = transpose(frameW) * ls.wi;
     vec3 f = bsdfEval(mat, wo, wiLocal);
     if (all(equal(f, vec3(0.0)))) return vec3(0.0);
-    vec3 origin = offsetOrigin(p, ng, ls.wi);
     if (occluded(origin, ls.wi, 0.0, ls.dist)) return vec3(0.0);
     // Area lights may hide each other: a sphere or rect light in front blocks this one.
     if (i < frame.lightCount) {

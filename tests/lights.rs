@@ -1,0 +1,169 @@
+//! Every light type against its analytic irradiance: a diffuse floor of
+//! albedo ρ, seen from straight above, lit by one light at a time, with
+//! direct lighting only (max_depth 1). The radiance of a floor point x is
+//! ρ/π · E(x); the test reconstructs x from the depth AOV of each pixel
+//! centre and compares the rendered radiance with the expected one.
+//!
+//! E(x): point light I cos θ / d²; directional light E_sun cos θ; sphere
+//! light π L (r/d)² cos θ (a sphere above the horizon acts as a point source
+//! of intensity π r² L); rect light: numerical quadrature (f64, 200 x 200)
+//! of L cos θ cos θ_l / d² over its area; uniform environment: π L_env (the
+//! floor sees the whole upper hemisphere).
+//!
+//! Bounds: the mean signed relative error over the lit pixels (the bias)
+//! within `BIAS_BOUND`; no pixel further than `OUTLIER_SIGMAS` times the RMS
+//! relative error from its expected value (a local bias shows as outliers);
+//! the RMS (Monte Carlo noise at 256 spp, plus the jittered pixel footprint
+//! against a pixel-centre reference) below `RMS_BOUND`. Pixels that see a
+//! sphere light directly are skipped.
+
+mod common;
+
+use glam::{DAffine3, DVec3, Vec3};
+use quadray::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::scene::{Light, Material, Scene};
+
+const ALBEDO: f64 = 0.7;
+const BIAS_BOUND: f64 = 0.01;
+const OUTLIER_SIGMAS: f64 = 6.0;
+const RMS_BOUND: f64 = 0.1;
+
+fn floor_scene() -> Scene {
+    let floor = FunctionalObject {
+        base: Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
+        perturbations: vec![],
+        clip: Some(Aabb::new(DVec3::new(-20.0, -0.5, -20.0), DVec3::new(20.0, 0.5, 20.0))),
+    };
+    let mut scene = common::scene_with(vec![common::object("floor", floor, DAffine3::IDENTITY)]);
+    scene.materials = vec![Material::diffuse("floor", Vec3::splat(ALBEDO as f32))];
+    scene.camera.position = DVec3::new(0.0, 8.0, 0.0);
+    scene.camera.look_at = DVec3::ZERO;
+    scene.camera.up = DVec3::new(0.0, 0.0, -1.0);
+    scene.camera.vfov_degrees = 60.0;
+    scene.image.width = 40;
+    scene.image.height = 40;
+    scene.image.spp = 256;
+    scene.image.max_depth = 1;
+    scene.lights.clear();
+    scene
+}
+
+fn rect_irradiance(x: DVec3, corner: DVec3, eu: DVec3, ev: DVec3, l: f64) -> f64 {
+    let n = eu.cross(ev);
+    let area = n.length();
+    let nl = n / area;
+    let k = 200;
+    let mut sum = 0.0;
+    for i in 0..k {
+        for j in 0..k {
+            let q = corner + eu * ((i as f64 + 0.5) / k as f64) + ev * ((j as f64 + 0.5) / k as f64);
+            let w = q - x;
+            let d2 = w.length_squared();
+            let wi = w / d2.sqrt();
+            let cos_r = wi.y.max(0.0);
+            let cos_l = (-nl.dot(wi)).max(0.0);
+            sum += l * cos_r * cos_l / d2;
+        }
+    }
+    sum * area / (k * k) as f64
+}
+
+fn check(name: &str, light: Option<Light>, background: f64, irradiance: impl Fn(DVec3) -> f64) {
+    let visible_sphere = match light {
+        Some(Light::Sphere { centre, radius, .. }) => Some((centre, radius)),
+        _ => None,
+    };
+    let mut scene = floor_scene();
+    scene.lights.extend(light);
+    scene.background = Vec3::splat(background as f32);
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let out = quadray::render_scene(&ctx, &scene, &mut |_, _| {}).unwrap();
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+
+    let (w, h) = (out.width as usize, out.height as usize);
+    let half = (0.5 * scene.camera.vfov_degrees).to_radians().tan();
+    let mut errors = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let depth = out.aov[i].depth as f64;
+            if !depth.is_finite() {
+                continue;
+            }
+            // Camera basis for a camera looking down -y with up -z: right = +x.
+            let nx = 2.0 * (x as f64 + 0.5) / w as f64 - 1.0;
+            let ny = 1.0 - 2.0 * (y as f64 + 0.5) / h as f64;
+            let dir = DVec3::new(nx * half * w as f64 / h as f64, -1.0, -ny * half).normalize();
+            if let Some((c, r)) = visible_sphere {
+                // The ray passes within a pixel's width of the light: skip.
+                let oc = c - scene.camera.position;
+                let miss = (oc - oc.dot(dir) * dir).length();
+                if miss < r + 2.0 * half * 8.0 / h as f64 {
+                    continue;
+                }
+            }
+            let p = scene.camera.position + depth * dir;
+            let expected = ALBEDO / std::f64::consts::PI * irradiance(p);
+            if expected < 1e-3 {
+                continue;
+            }
+            errors.push((out.radiance[i][0] as f64 - expected) / expected);
+        }
+    }
+    let n = errors.len() as f64;
+    let bias = errors.iter().sum::<f64>() / n;
+    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt();
+    let worst = errors.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    println!(
+        "{name}: {} lit pixels, bias {bias:+.4} (bound ±{BIAS_BOUND}), RMS {rms:.4} (bound {RMS_BOUND}), worst \
+         {worst:.4} = {:.1} RMS (bound {OUTLIER_SIGMAS})",
+        errors.len(),
+        worst / rms.max(1e-12)
+    );
+    assert!(errors.len() > 500, "{name}: too few lit pixels");
+    assert!(bias.abs() <= BIAS_BOUND, "{name}: bias {bias}");
+    assert!(rms <= RMS_BOUND, "{name}: RMS {rms}");
+    assert!(worst <= OUTLIER_SIGMAS * rms.max(1e-4), "{name}: outlier {worst}");
+}
+
+#[test]
+fn point_light() {
+    let pos = DVec3::new(1.0, 3.0, -0.5);
+    let i = 20.0;
+    check("point", Some(Light::Point { position: pos, intensity: Vec3::splat(i as f32) }), 0.0, |x| {
+        let w = pos - x;
+        i * (w.y / w.length()) / w.length_squared()
+    });
+}
+
+#[test]
+fn directional_light() {
+    let dir = DVec3::new(0.3, 1.0, 0.2).normalize();
+    check("directional", Some(Light::Directional { direction: dir, irradiance: Vec3::splat(2.0) }), 0.0, |_| {
+        2.0 * dir.y
+    });
+}
+
+#[test]
+fn sphere_light() {
+    let (c, r, l) = (DVec3::new(-1.0, 2.5, 1.0), 0.4, 5.0);
+    check("sphere", Some(Light::Sphere { centre: c, radius: r, radiance: Vec3::splat(l as f32) }), 0.0, |x| {
+        let w = c - x;
+        std::f64::consts::PI * l * r * r / w.length_squared() * (w.y / w.length())
+    });
+}
+
+#[test]
+fn rect_light() {
+    let (corner, eu, ev, l) = (DVec3::new(-1.5, 2.0, -1.0), DVec3::new(3.0, 0.0, 0.0), DVec3::new(0.0, 0.0, 2.0), 4.0);
+    check("rect", Some(Light::Rect { corner, edge_u: eu, edge_v: ev, radiance: Vec3::splat(l as f32) }), 0.0, |x| {
+        rect_irradiance(x, corner, eu, ev, l)
+    });
+}
+
+#[test]
+fn uniform_environment() {
+    check("environment", None, 0.5, |_| std::f64::consts::PI * 0.5);
+}
