@@ -40,8 +40,10 @@ fn sphere_scene(n: usize) -> Scene {
             shape,
             transform: DAffine3::IDENTITY,
             material: 0,
+            uv: Default::default(),
         }],
         lights: vec![],
+        textures: vec![],
     }
 }
 

@@ -29,7 +29,10 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::{Camera, ConductorFresnel, ImageSettings, Light, Material, MaterialKind, Scene, SceneObject};
+use super::{
+    Camera, ConductorFresnel, ImageSettings, Light, Material, MaterialKind, MaterialMaps, Scene, SceneObject,
+    UvSettings,
+};
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 
 /// The file name used in messages about [`DEFAULT_SCENE`].
@@ -826,7 +829,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
 
     let lights = raw.lights.iter().enumerate().map(|(i, l)| build_light(src, i, l)).collect::<Result<Vec<_>, _>>()?;
 
-    Ok(Scene { image, camera, background, materials, objects, lights })
+    Ok(Scene { image, camera, background, materials, objects, lights, textures: Vec::new() })
 }
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {
@@ -1013,7 +1016,13 @@ fn build_object(src: &Source, i: usize, raw: &Spanned<RawObject>, material: usiz
         DQuat::from_euler(EulerRot::XYZ, rotate.x.to_radians(), rotate.y.to_radians(), rotate.z.to_radians());
     let transform = DAffine3::from_scale_rotation_translation(scale, rotation, translate);
 
-    Ok(SceneObject { name: o.name.clone().unwrap_or_else(|| format!("objects[{i}]")), shape, transform, material })
+    Ok(SceneObject {
+        name: o.name.clone().unwrap_or_else(|| format!("objects[{i}]")),
+        shape,
+        transform,
+        material,
+        uv: UvSettings::default(),
+    })
 }
 
 fn geometry_error(
@@ -1151,6 +1160,7 @@ fn build_material(src: &Source, i: usize, raw: &Spanned<RawMaterial>) -> Result<
         kind,
         albedo,
         emission: m.emission.as_ref().map_or(Vec3::ZERO, |e| e.get_ref().get().as_vec3()),
+        maps: MaterialMaps::default(),
     })
 }
 

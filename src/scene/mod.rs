@@ -4,7 +4,7 @@
 
 pub mod file;
 
-use glam::{DAffine3, DVec3, Vec3};
+use glam::{DAffine3, DVec2, DVec3, Vec3};
 
 use crate::geometry::FunctionalObject;
 
@@ -94,13 +94,85 @@ pub struct Material {
     pub albedo: Vec3,
     /// Emitted radiance (linear RGB).
     pub emission: Vec3,
+    /// Texture maps (indices into [`Scene::textures`]).
+    pub maps: MaterialMaps,
+}
+
+/// The texture maps of a material, as indices into [`Scene::textures`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MaterialMaps {
+    /// Colour map: multiplies `albedo` (sRGB-decoded RGB).
+    pub albedo: Option<usize>,
+    /// Tangent-space normal map (RGB = (n + 1) / 2, linear).
+    pub normal: Option<usize>,
+    /// Roughness map (R channel, linear): replaces the material's roughness.
+    pub roughness: Option<usize>,
+    /// Displacement (height) map (R channel, linear, in [0, 1]) and its
+    /// height scale in object units. Shading only: it tilts the shading
+    /// normal (bump mapping); the surface F' = 0 itself does not move.
+    pub displacement: Option<(usize, f32)>,
 }
 
 impl Material {
     /// A Lambertian material.
     pub fn diffuse(name: &str, albedo: Vec3) -> Self {
-        Self { name: name.into(), kind: MaterialKind::Diffuse, albedo, emission: Vec3::ZERO }
+        Self {
+            name: name.into(),
+            kind: MaterialKind::Diffuse,
+            albedo,
+            emission: Vec3::ZERO,
+            maps: MaterialMaps::default(),
+        }
     }
+}
+
+/// How texture coordinates (u, v) are laid on an object, in its own frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum UvMapping {
+    /// u = p · u_axis, v = p · v_axis (the axes' lengths set the scale).
+    Planar {
+        /// Gradient of u.
+        u_axis: DVec3,
+        /// Gradient of v.
+        v_axis: DVec3,
+    },
+    /// u = azimuth around +y / 2π + 1/2 (azimuth 0 along +x, toward +z),
+    /// v = angle from +y / π (0 at the top).
+    Spherical,
+    /// u as for `Spherical`, v = y.
+    Cylindrical,
+}
+
+/// Texture coordinates of an object: (u, v) = mapping(p) · scale + offset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvSettings {
+    /// The mapping.
+    pub mapping: UvMapping,
+    /// Repeats per unit of the mapping's coordinates.
+    pub scale: DVec2,
+    /// Offset added after scaling.
+    pub offset: DVec2,
+}
+
+impl Default for UvSettings {
+    fn default() -> Self {
+        Self { mapping: UvMapping::Spherical, scale: DVec2::ONE, offset: DVec2::ZERO }
+    }
+}
+
+/// A texture with its mip chain, in linear RGBA (colour maps already
+/// sRGB-decoded). Level 0 is `width` x `height` (powers of two); each next
+/// level halves both, down to 1 x 1.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureImage {
+    /// Where it came from (a path, or a description of a generated texture).
+    pub source: String,
+    /// Width of level 0.
+    pub width: u32,
+    /// Height of level 0.
+    pub height: u32,
+    /// Texels of every level, row 0 at the top (v = 0), row-major.
+    pub levels: Vec<Vec<[f32; 4]>>,
 }
 
 /// A functional object placed in the world.
@@ -114,6 +186,8 @@ pub struct SceneObject {
     pub transform: DAffine3,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// Texture coordinates.
+    pub uv: UvSettings,
 }
 
 /// A light source.
@@ -172,4 +246,6 @@ pub struct Scene {
     pub objects: Vec<SceneObject>,
     /// Lights.
     pub lights: Vec<Light>,
+    /// Texture maps used by the materials.
+    pub textures: Vec<TextureImage>,
 }

@@ -29,7 +29,7 @@ pub fn spread_bumps(n: usize, on: f64, r: f64, f: f64, alternate: bool) -> Vec<P
 
 /// An object from its parts.
 pub fn object(name: &str, shape: FunctionalObject, transform: DAffine3) -> SceneObject {
-    SceneObject { name: name.into(), shape, transform, material: 0 }
+    SceneObject { name: name.into(), shape, transform, material: 0, uv: Default::default() }
 }
 
 /// A transform from scale, Euler XYZ angles in degrees, and translation.
@@ -47,6 +47,7 @@ pub fn scene_with(objects: Vec<SceneObject>) -> Scene {
         materials: vec![Material::diffuse("grey", Vec3::splat(0.8))],
         objects,
         lights: vec![Light::Point { position: DVec3::new(3.0, 6.0, 4.0), intensity: Vec3::splat(40.0) }],
+        textures: vec![],
     }
 }
 
