@@ -20,6 +20,11 @@ struct Material {
     uint fresnel;       // FRESNEL_COMPLEX or FRESNEL_SCHLICK (conductor)
     float eta[3];       // conductor: η per RGB, or the Schlick f0
     float k[3];         // conductor: κ per RGB
+    uint albedoMap;     // texture indices, NO_TEXTURE when absent
+    uint normalMap;
+    uint roughnessMap;
+    uint displacementMap;
+    float displacementScale;  // object units per unit of displacement
 };
 
 // An orthonormal basis around n (Duff et al., "Building an Orthonormal Basis,

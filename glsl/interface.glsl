@@ -20,7 +20,12 @@ struct Quadric {
 struct Object {
     Quadric base;
     uint material;
-    uint firstCell;  // cell of primitive 0 of the object's bottom level
+    uint firstCell;    // cell of primitive 0 of the object's bottom level
+    uint uvMapping;    // UV_*
+    float uAxis[3];    // planar mapping: gradients of u and v (object frame)
+    float vAxis[3];
+    vec2 uvScale;
+    vec2 uvOffset;
 };
 
 // A perturbation f · max(Q, 0)³. Q is stored relative to `centre`, the centre

@@ -210,9 +210,11 @@ vec3 cellGradient(uint object, uint cellIndex, vec3 p) {
 }
 
 struct SceneHit {
-    float t;        // NO_ROOT on a miss
+    float t;             // NO_ROOT on a miss
     uint object;
-    vec3 normal;    // world space, outward (-∇F'), unit length
+    vec3 normal;         // world space, outward (-∇F'), unit length
+    vec3 objectPoint;    // the hit in the object's frame
+    mat3 worldToObject;  // linear part of the world-to-object transform
 };
 
 // The object (instance custom index) and its cell (index into cells[]) of
@@ -246,15 +248,18 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
     h.t = NO_ROOT;
     h.object = NO_HIT;
     h.normal = vec3(0.0);
+    h.objectPoint = vec3(0.0);
+    h.worldToObject = mat3(1.0);
     if (rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionGeneratedEXT) {
         h.t = rayQueryGetIntersectionTEXT(rq, true);
         h.object = candidateObject(rq, true);
         uint cell = candidateCell(rq, h.object, true);
         vec3 oo = rayQueryGetIntersectionObjectRayOriginEXT(rq, true);
         vec3 od = rayQueryGetIntersectionObjectRayDirectionEXT(rq, true);
-        vec3 g = cellGradient(h.object, cell, oo + h.t * od);
-        mat4x3 w2o = rayQueryGetIntersectionWorldToObjectEXT(rq, true);
-        vec3 n = -(transpose(mat3(w2o)) * g);
+        h.objectPoint = oo + h.t * od;
+        vec3 g = cellGradient(h.object, cell, h.objectPoint);
+        h.worldToObject = mat3(rayQueryGetIntersectionWorldToObjectEXT(rq, true));
+        vec3 n = -(transpose(h.worldToObject) * g);
         float len = length(n);
         h.normal = len > 0.0 ? n / len : -d;
     }

@@ -3,9 +3,12 @@
 // next-event estimation and multiple importance sampling (power heuristic)
 // at every non-specular vertex, Russian roulette after RR_DEPTH bounces, and
 // at most `maxDepth` bounces (1 = direct lighting only).
+#extension GL_EXT_nonuniform_qualifier : require
+
 #include "intersect.glsl"
 #include "random.glsl"
 #include "lights.glsl"
+#include "uv.glsl"
 
 layout(local_size_x = RENDER_GROUP, local_size_y = RENDER_GROUP) in;
 
@@ -34,6 +37,68 @@ struct Aov {
     float albedo[3];
 };
 layout(set = 0, binding = BINDING_AOV, scalar) writeonly buffer Aovs { Aov aovs[]; };
+
+// Texture maps with their mip chains (unused slots hold a white texel).
+layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTURES];
+
+vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index)], uv, 0.0); }
+
+// Height of a displacement map and its derivatives in (u, v), by central
+// differences one texel apart.
+vec3 heightAndSlopes(uint index, vec2 uv) {
+    vec2 texel = 1.0 / vec2(textureSize(textures[nonuniformEXT(index)], 0));
+    float h = mapAt(index, uv).r;
+    float dhdu = (mapAt(index, uv + vec2(texel.x, 0.0)).r - mapAt(index, uv - vec2(texel.x, 0.0)).r) / (2.0 * texel.x);
+    float dhdv = (mapAt(index, uv + vec2(0.0, texel.y)).r - mapAt(index, uv - vec2(0.0, texel.y)).r) / (2.0 * texel.y);
+    return vec3(h, dhdu, dhdv);
+}
+
+// The material at a hit with its texture maps applied, and the shading normal
+// (outward, tilted by the normal and displacement maps).
+Material surfaceAt(SceneHit h, out vec3 shadingNormal) {
+    Object obj = objects[h.object];
+    Material mat = materials[obj.material];
+    shadingNormal = h.normal;
+    if (mat.albedoMap == NO_TEXTURE && mat.normalMap == NO_TEXTURE && mat.roughnessMap == NO_TEXTURE
+        && mat.displacementMap == NO_TEXTURE) {
+        return mat;
+    }
+    SurfaceUv s = objectUv(obj, h.objectPoint);
+    if (mat.albedoMap != NO_TEXTURE) {
+        vec3 a = v3(mat.albedo) * mapAt(mat.albedoMap, s.uv).rgb;
+        mat.albedo = float[3](a.x, a.y, a.z);
+    }
+    if (mat.roughnessMap != NO_TEXTURE) mat.roughness = clamp(mapAt(mat.roughnessMap, s.uv).r, 0.0, 1.0);
+    if (mat.normalMap == NO_TEXTURE && mat.displacementMap == NO_TEXTURE) return mat;
+
+    // World-space gradients of u and v, then the tangents.
+    vec3 n = h.normal;
+    vec3 gu = transpose(h.worldToObject) * s.gradU;
+    vec3 gv = transpose(h.worldToObject) * s.gradV;
+    vec3 dpdu, dpdv;
+    tangentsFromGradients(gu, gv, n, dpdu, dpdv);
+    if (mat.displacementMap != NO_TEXTURE) {
+        // Bump mapping: the normal of p + scale · height(u, v) · n.
+        vec3 hs = heightAndSlopes(mat.displacementMap, s.uv) * mat.displacementScale;
+        vec3 bent = cross(dpdu + hs.y * n, dpdv + hs.z * n);
+        float len = length(bent);
+        if (len > 0.0) n = dot(bent, n) >= 0.0 ? bent / len : -bent / len;
+    }
+    if (mat.normalMap != NO_TEXTURE) {
+        vec3 c = mapAt(mat.normalMap, s.uv).rgb * 2.0 - 1.0;
+        vec3 t = dpdu - n * dot(n, dpdu);
+        float tl = length(t);
+        mat3 f = frameAround(n);
+        t = tl > 0.0 ? t / tl : f[0];
+        vec3 b = cross(n, t);
+        if (dot(b, dpdv) < 0.0) b = -b;
+        vec3 m = c.x * t + c.y * b + c.z * n;
+        float ml = length(m);
+        if (ml > 0.0) n = m / ml;
+    }
+    shadingNormal = n;
+    return mat;
+}
 
 layout(push_constant, scalar) uniform Push {
     uvec2 tileOrigin;
@@ -115,11 +180,12 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
             break;
         }
 
-        Material mat = materials[objects[h.object].material];
+        vec3 ns;
+        Material mat = surfaceAt(h, ns);
         vec3 p = o + h.t * d;
         radiance += throughput * v3(mat.emission);
         // Two-sided shading; dielectrics keep the outward normal to tell inside from outside.
-        vec3 n = mat.kind == MATERIAL_DIELECTRIC || dot(h.normal, d) < 0.0 ? h.normal : -h.normal;
+        vec3 n = mat.kind == MATERIAL_DIELECTRIC || dot(h.normal, d) < 0.0 ? ns : -ns;
         mat3 frameW = frameAround(n);
         vec3 wo = transpose(frameW) * -d;
         bool last = bounce + 1u == frame.maxDepth;
@@ -158,7 +224,8 @@ void main() {
         aov.depth = h.object == NO_HIT ? 1.0 / 0.0 : h.t;
         vec3 n = h.normal;
         aov.normal = float[3](n.x, n.y, n.z);
-        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(materials[objects[h.object].material].albedo);
+        vec3 ns;
+        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, ns).albedo);
         aov.albedo = float[3](alb.x, alb.y, alb.z);
         aovs[idx] = aov;
     }

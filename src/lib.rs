@@ -11,9 +11,11 @@
 pub mod geometry;
 pub mod output;
 pub mod passes;
+pub mod sampling;
 pub mod scene;
 pub mod shader_interface;
 mod shaders;
+pub mod texture;
 pub mod vk;
 
 /// Errors of rendering a scene.
@@ -22,6 +24,9 @@ pub enum RenderError {
     /// The Vulkan backend failed.
     #[error(transparent)]
     Vk(#[from] vk::VkError),
+    /// The scene uses more texture maps than the shader's texture array holds.
+    #[error("the scene uses {0} texture maps; at most {max} are supported", max = shader_interface::MAX_TEXTURES - 1)]
+    TooManyTextures(usize),
     /// An object cannot be rendered.
     #[error("object `{object}`: {source}")]
     Geometry {

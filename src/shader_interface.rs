@@ -27,6 +27,18 @@ pub const BINDING_AOV: u32 = 9;
 pub const BINDING_RAYS: u32 = 5;
 /// Descriptor binding of the output hits (probe pass).
 pub const BINDING_HITS: u32 = 6;
+/// Descriptor binding of the texture array (render pass).
+pub const BINDING_TEXTURES: u32 = 10;
+/// Size of the texture array: a scene may use at most this many texture maps.
+pub const MAX_TEXTURES: u32 = 32;
+/// Texture index meaning "no map".
+pub const NO_TEXTURE: u32 = 4294967295;
+/// UV mapping: planar.
+pub const UV_PLANAR: u32 = 0;
+/// UV mapping: spherical.
+pub const UV_SPHERICAL: u32 = 1;
+/// UV mapping: cylindrical.
+pub const UV_CYLINDRICAL: u32 = 2;
 /// Workgroup width and height of the render pass.
 pub const RENDER_GROUP: u32 = 8;
 /// Workgroup size of the probe pass.

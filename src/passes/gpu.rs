@@ -6,10 +6,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DAffine3, DVec3};
 
 use crate::geometry::{Perturbation, Quadric};
-use crate::scene::{ConductorFresnel, Light, Material, MaterialKind};
+use crate::scene::{ConductorFresnel, Light, Material, MaterialKind, SceneObject, UvMapping};
 use crate::shader_interface::{
     FRESNEL_COMPLEX, FRESNEL_SCHLICK, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_RECT, LIGHT_SPHERE, MATERIAL_CONDUCTOR,
-    MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_MIRROR,
+    MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_MIRROR, NO_TEXTURE, UV_CYLINDRICAL, UV_PLANAR, UV_SPHERICAL,
 };
 
 /// `Quadric` in interface.glsl: A's six entries, b, c.
@@ -45,6 +45,37 @@ pub struct GpuObject {
     pub material: u32,
     /// Index of the object's first cell in the cell table.
     pub first_cell: u32,
+    /// `UV_*`.
+    pub uv_mapping: u32,
+    /// Planar mapping: gradient of u (object frame).
+    pub u_axis: [f32; 3],
+    /// Planar mapping: gradient of v.
+    pub v_axis: [f32; 3],
+    /// UV scale.
+    pub uv_scale: [f32; 2],
+    /// UV offset.
+    pub uv_offset: [f32; 2],
+}
+
+impl GpuObject {
+    /// The object's base quadric, material and texture coordinates.
+    pub fn new(object: &SceneObject, first_cell: u32) -> Self {
+        let (uv_mapping, u_axis, v_axis) = match object.uv.mapping {
+            UvMapping::Planar { u_axis, v_axis } => (UV_PLANAR, u_axis, v_axis),
+            UvMapping::Spherical => (UV_SPHERICAL, DVec3::X, DVec3::Z),
+            UvMapping::Cylindrical => (UV_CYLINDRICAL, DVec3::X, DVec3::Z),
+        };
+        Self {
+            base: GpuQuadric::from(&object.shape.base),
+            material: object.material as u32,
+            first_cell,
+            uv_mapping,
+            u_axis: u_axis.as_vec3().to_array(),
+            v_axis: v_axis.as_vec3().to_array(),
+            uv_scale: object.uv.scale.as_vec2().to_array(),
+            uv_offset: object.uv.offset.as_vec2().to_array(),
+        }
+    }
 }
 
 /// `Perturbation` in interface.glsl.
@@ -106,6 +137,16 @@ pub struct GpuMaterial {
     pub eta: [f32; 3],
     /// Conductor κ per RGB.
     pub k: [f32; 3],
+    /// Texture index of the colour map, or `NO_TEXTURE`.
+    pub albedo_map: u32,
+    /// Texture index of the normal map, or `NO_TEXTURE`.
+    pub normal_map: u32,
+    /// Texture index of the roughness map, or `NO_TEXTURE`.
+    pub roughness_map: u32,
+    /// Texture index of the displacement map, or `NO_TEXTURE`.
+    pub displacement_map: u32,
+    /// Height of a displacement value of 1, in object units.
+    pub displacement_scale: f32,
 }
 
 impl From<&Material> for GpuMaterial {
@@ -114,6 +155,11 @@ impl From<&Material> for GpuMaterial {
             albedo: m.albedo.to_array(),
             emission: m.emission.to_array(),
             ior: 1.0,
+            albedo_map: m.maps.albedo.map_or(NO_TEXTURE, |i| i as u32),
+            normal_map: m.maps.normal.map_or(NO_TEXTURE, |i| i as u32),
+            roughness_map: m.maps.roughness.map_or(NO_TEXTURE, |i| i as u32),
+            displacement_map: m.maps.displacement.map_or(NO_TEXTURE, |(i, _)| i as u32),
+            displacement_scale: m.maps.displacement.map_or(0.0, |(_, s)| s),
             ..Default::default()
         };
         match &m.kind {
@@ -290,10 +336,10 @@ pub struct ProbePush {
 
 const _: () = {
     assert!(std::mem::size_of::<GpuQuadric>() == 40);
-    assert!(std::mem::size_of::<GpuObject>() == 48);
+    assert!(std::mem::size_of::<GpuObject>() == 92);
     assert!(std::mem::size_of::<GpuPerturbation>() == 60);
     assert!(std::mem::size_of::<GpuCell>() == 32);
-    assert!(std::mem::size_of::<GpuMaterial>() == 64);
+    assert!(std::mem::size_of::<GpuMaterial>() == 84);
     assert!(std::mem::size_of::<GpuLight>() == 56);
     assert!(std::mem::size_of::<GpuFrame>() == 80);
     assert!(std::mem::size_of::<GpuAov>() == 28);

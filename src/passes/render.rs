@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::gpu::{GpuAov, GpuFrame, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use crate::scene::Scene;
-use crate::shader_interface::RENDER_GROUP;
+use crate::shader_interface::{MAX_TEXTURES, RENDER_GROUP};
 use crate::vk::{
     full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation,
 };
@@ -84,7 +84,7 @@ pub fn render(
 
     let mut kinds = vec![BindingKind::AccelerationStructure];
     kinds.extend([BindingKind::StorageBuffer; 7]);
-    kinds.extend([BindingKind::StorageImage, BindingKind::StorageBuffer]);
+    kinds.extend([BindingKind::StorageImage, BindingKind::StorageBuffer, BindingKind::SampledImages(MAX_TEXTURES)]);
     let pipeline =
         ComputePipeline::new(device, &shaders::render(), &kinds, std::mem::size_of::<RenderPush>() as u32, &[])?;
     let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
@@ -99,6 +99,7 @@ pub fn render(
         Binding::Buffer(&frame_buf),
         Binding::Image(&accum),
         Binding::Buffer(&aov),
+        gpu.texture_binding(),
     ]);
 
     let tiles: Vec<[u32; 4]> = (0..height)

@@ -6,10 +6,11 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
 
-use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation, GpuQuadric};
+use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
 use crate::geometry::{Aabb, CellParams};
-use crate::scene::Scene;
-use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device};
+use crate::scene::{Scene, TextureImage};
+use crate::shader_interface::MAX_TEXTURES;
+use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
 use crate::RenderError;
 
 /// Sizes of what a scene put on the GPU.
@@ -46,8 +47,29 @@ pub struct GpuScene {
     pub lights: Buffer,
     /// Number of lights.
     pub light_count: u32,
+    /// The scene's texture maps, then a 1x1 white texture filling the
+    /// remaining slots of the shader's texture array.
+    pub textures: Vec<Image>,
+    /// The sampler for every texture.
+    pub sampler: Sampler,
     /// Sizes.
     pub stats: GeometryStats,
+}
+
+/// Uploads a texture with its mip chain as an RGBA32F image.
+fn upload_texture(device: &Arc<Device>, cmds: &mut Commands, t: &TextureImage) -> Result<Image, RenderError> {
+    let texels: Vec<[f32; 4]> = t.levels.iter().flatten().copied().collect();
+    let staging = Buffer::with_data(device, "texture upload", &texels, vk::BufferUsageFlags::TRANSFER_SRC)?;
+    let image = Image::with_levels(
+        device,
+        &t.source,
+        vk::Extent2D { width: t.width, height: t.height },
+        t.levels.len() as u32,
+        vk::Format::R32G32B32A32_SFLOAT,
+        vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+    )?;
+    cmds.run(|_, cmd| image.upload_levels(cmd, &staging, 16))?;
+    Ok(image)
 }
 
 /// Rounds a box outward to f32.
@@ -110,11 +132,7 @@ impl GpuScene {
             let first_perturbation = perturbations.len() as u32;
             perturbations.extend(object.shape.perturbations.iter().map(GpuPerturbation::from));
             let first_cell = cells.len() as u32;
-            objects.push(GpuObject {
-                base: GpuQuadric::from(&object.shape.base),
-                material: object.material as u32,
-                first_cell,
-            });
+            objects.push(GpuObject::new(object, first_cell));
             if object_cells.is_empty() {
                 continue;
             }
@@ -135,6 +153,13 @@ impl GpuScene {
             .collect();
         let tlas = AccelerationStructure::top_level(device, cmds, &instances)?;
 
+        if scene.textures.len() >= MAX_TEXTURES as usize {
+            return Err(RenderError::TooManyTextures(scene.textures.len()));
+        }
+        let mut textures =
+            scene.textures.iter().map(|t| upload_texture(device, cmds, t)).collect::<Result<Vec<_>, _>>()?;
+        let white = TextureImage { source: "white".into(), width: 1, height: 1, levels: vec![vec![[1.0; 4]]] };
+        textures.push(upload_texture(device, cmds, &white)?);
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
         let lights: Vec<GpuLight> = scene.lights.iter().map(GpuLight::from).collect();
 
@@ -155,10 +180,20 @@ impl GpuScene {
             materials: storage(device, "materials", bytemuck::cast_slice(&materials))?,
             light_count: lights.len() as u32,
             lights: storage(device, "lights", bytemuck::cast_slice(&lights))?,
+            textures,
+            sampler: Sampler::linear_repeat(device)?,
             tlas,
             _blases: blases,
             stats,
         })
+    }
+
+    /// The texture array: every scene texture, the rest of the slots filled
+    /// with the white texture.
+    pub fn texture_binding(&self) -> Binding<'_> {
+        let white = self.textures.last().expect("the white texture");
+        let images = (0..MAX_TEXTURES as usize).map(|i| self.textures.get(i).unwrap_or(white)).collect();
+        Binding::Textures(images, &self.sampler)
     }
 
     /// The bindings `BINDING_TLAS..=BINDING_CELL_LISTS` shared by all passes.

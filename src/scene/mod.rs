@@ -108,7 +108,7 @@ pub struct MaterialMaps {
     /// Roughness map (R channel, linear): replaces the material's roughness.
     pub roughness: Option<usize>,
     /// Displacement (height) map (R channel, linear, in [0, 1]) and its
-    /// height scale in object units. Shading only: it tilts the shading
+    /// height scale in world units. Shading only: it tilts the shading
     /// normal (bump mapping); the surface F' = 0 itself does not move.
     pub displacement: Option<(usize, f32)>,
 }

@@ -74,6 +74,9 @@ fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String>
         if f12.scalar_block_layout == 0 {
             missing.push("scalarBlockLayout".into());
         }
+        if f12.shader_sampled_image_array_non_uniform_indexing == 0 {
+            missing.push("shaderSampledImageArrayNonUniformIndexing".into());
+        }
         if fas.acceleration_structure == 0 {
             missing.push("accelerationStructure".into());
         }
@@ -151,6 +154,7 @@ impl Device {
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
             .buffer_device_address(true)
             .scalar_block_layout(true)
+            .shader_sampled_image_array_non_uniform_indexing(true)
             .host_query_reset(supported12.host_query_reset == vk::TRUE);
         let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
         let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);

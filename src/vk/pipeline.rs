@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{AccelerationStructure, Buffer, Device, Image, VkError};
+use super::{AccelerationStructure, Buffer, Device, Image, Sampler, VkError};
 
 /// What a descriptor binding holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,6 +15,8 @@ pub enum BindingKind {
     StorageBuffer,
     /// A storage image (GENERAL layout).
     StorageImage,
+    /// An array of this many combined image samplers (SHADER_READ_ONLY_OPTIMAL).
+    SampledImages(u32),
 }
 
 impl BindingKind {
@@ -23,6 +25,14 @@ impl BindingKind {
             Self::AccelerationStructure => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
             Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             Self::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            Self::SampledImages(_) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        }
+    }
+
+    fn count(self) -> u32 {
+        match self {
+            Self::SampledImages(n) => n,
+            _ => 1,
         }
     }
 }
@@ -35,6 +45,8 @@ pub enum Binding<'a> {
     Buffer(&'a Buffer),
     /// A storage image in GENERAL layout.
     Image(&'a Image),
+    /// Sampled images (one per array element) with one sampler.
+    Textures(Vec<&'a Image>, &'a Sampler),
 }
 
 /// A compute pipeline, its layout, and one descriptor set.
@@ -70,7 +82,7 @@ impl ComputePipeline {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(i as u32)
                     .descriptor_type(k.descriptor_type())
-                    .descriptor_count(1)
+                    .descriptor_count(k.count())
                     .stage_flags(vk::ShaderStageFlags::COMPUTE)
             })
             .collect();
@@ -121,8 +133,8 @@ impl ComputePipeline {
         for k in bindings {
             let ty = k.descriptor_type();
             match sizes.iter_mut().find(|s| s.ty == ty) {
-                Some(s) => s.descriptor_count += 1,
-                None => sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: 1 }),
+                Some(s) => s.descriptor_count += k.count(),
+                None => sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: k.count() }),
             }
         }
         this.pool = unsafe {
@@ -147,9 +159,20 @@ impl ComputePipeline {
                 Binding::Buffer(b) => {
                     buffer_infos.push([vk::DescriptorBufferInfo::default().buffer(b.raw).range(vk::WHOLE_SIZE)])
                 }
-                Binding::Image(i) => image_infos.push([vk::DescriptorImageInfo::default()
+                Binding::Image(i) => image_infos.push(vec![vk::DescriptorImageInfo::default()
                     .image_view(i.view)
                     .image_layout(vk::ImageLayout::GENERAL)]),
+                Binding::Textures(images, sampler) => image_infos.push(
+                    images
+                        .iter()
+                        .map(|i| {
+                            vk::DescriptorImageInfo::default()
+                                .image_view(i.view)
+                                .sampler(sampler.raw)
+                                .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
+                        })
+                        .collect(),
+                ),
                 Binding::AccelerationStructure(a) => as_handles.push([a.raw]),
             }
         }
@@ -167,6 +190,13 @@ impl ComputePipeline {
                     writes
                         .push(base.descriptor_type(vk::DescriptorType::STORAGE_BUFFER).buffer_info(&buffer_infos[bi]));
                     bi += 1;
+                }
+                (Binding::Textures(images, _), BindingKind::SampledImages(n)) => {
+                    assert_eq!(images.len(), n as usize, "binding {i}: one image per array element");
+                    writes.push(
+                        base.descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER).image_info(&image_infos[ii]),
+                    );
+                    ii += 1;
                 }
                 (Binding::Image(_), BindingKind::StorageImage) => {
                     writes.push(base.descriptor_type(vk::DescriptorType::STORAGE_IMAGE).image_info(&image_infos[ii]));
