@@ -54,17 +54,22 @@ vec3 sampleUniformSphere(vec2 u) {
 // EGSR 2007; Heitz, "Understanding the Masking-Shadowing Function in
 // Microfacet-Based BRDFs", JCGT 2014 (height-correlated G2).
 
+// D(m) = α² / (π (m.z² (α² − 1) + 1)²), with the denominator written as
+// (m.x² + m.y²) + α² m.z² (equal for unit m), which does not cancel near the
+// peak of a sharp lobe in f32.
 float ggxD(vec3 m, float a) {
     if (m.z <= 0.0) return 0.0;
     float a2 = a * a;
-    float t = m.z * m.z * (a2 - 1.0) + 1.0;
+    float t = (m.x * m.x + m.y * m.y) + a2 * m.z * m.z;
     return a2 / (PI * t * t);
 }
 
+// Λ(w) = (sqrt(1 + q) − 1) / 2 with q = α² tan²θ, as q / (2 (sqrt(1 + q) + 1)).
 float ggxLambda(vec3 w, float a) {
     float z2 = w.z * w.z;
     if (z2 <= 0.0) return 1e30;
-    return 0.5 * (sqrt(1.0 + a * a * (w.x * w.x + w.y * w.y) / z2) - 1.0);
+    float q = a * a * (w.x * w.x + w.y * w.y) / z2;
+    return q / (2.0 * (sqrt(1.0 + q) + 1.0));
 }
 
 float ggxG1(vec3 w, float a) { return 1.0 / (1.0 + ggxLambda(w, a)); }
@@ -183,6 +188,7 @@ BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
     s.wi = vec3(0.0, 0.0, 1.0);
     if (mat.kind == MATERIAL_DIELECTRIC) {
         // Smooth dielectric (rough ones are rendered smooth for now).
+        if (wo.z == 0.0) return s;
         float f = fresnelDielectric(wo.z, mat.ior);
         if (u.z < f) {
             s.wi = vec3(-wo.x, -wo.y, wo.z);

@@ -7,6 +7,7 @@
 #ifndef LIGHTS_GLSL
 #define LIGHTS_GLSL
 
+#include "common.glsl"
 #include "bsdf.glsl"
 
 struct Light {
@@ -18,7 +19,6 @@ struct Light {
     float edgeV[3];     // rect; emits toward edgeU × edgeV
 };
 
-layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
 
 struct LightSample {
     vec3 wi;
@@ -62,23 +62,25 @@ float rectHit(vec3 o, vec3 d, Light l) {
     return (a >= 0.0 && a <= 1.0 && b >= 0.0 && b <= 1.0) ? t : NO_ROOT;
 }
 
-// Samples a direction toward light i (or the environment, i == lightCount)
-// from x.
-LightSample sampleLight(uint i, uint lightCount, vec3 background, vec3 x, vec2 u) {
+// Samples a direction toward the uniform environment of radiance `background`.
+LightSample sampleEnvironment(vec3 background, vec2 u) {
+    LightSample s;
+    s.wi = sampleUniformSphere(u);
+    s.dist = 1e30;
+    s.radiance = background;
+    s.pdf = 1.0 / (4.0 * PI);
+    s.valid = true;
+    return s;
+}
+
+// Samples a direction toward light l from x.
+LightSample sampleLight(Light l, vec3 x, vec2 u) {
     LightSample s;
     s.valid = false;
     s.pdf = 0.0;
     s.dist = 1e30;
     s.radiance = vec3(0.0);
     s.wi = vec3(0.0, 0.0, 1.0);
-    if (i == lightCount) {
-        s.wi = sampleUniformSphere(u);
-        s.radiance = background;
-        s.pdf = 1.0 / (4.0 * PI);
-        s.valid = true;
-        return s;
-    }
-    Light l = lights[i];
     vec3 p = v3(l.position);
     if (l.kind == LIGHT_POINT) {
         vec3 toL = p - x;
@@ -94,9 +96,13 @@ LightSample sampleLight(uint i, uint lightCount, vec3 background, vec3 x, vec2 u
         vec3 toC = p - x;
         float d = length(toC);
         if (d <= l.radius) return s;
-        float cosMax = sqrt(max(0.0, 1.0 - (l.radius * l.radius) / (d * d)));
-        float cosA = 1.0 - u.x * (1.0 - cosMax);
-        float sinA = sqrt(max(0.0, 1.0 - cosA * cosA));
+        // 1 − cos θmax = sin²θmax / (1 + cos θmax): no cancellation for small lights.
+        float sin2Max = (l.radius * l.radius) / (d * d);
+        float cosMax = sqrt(max(0.0, 1.0 - sin2Max));
+        float oneMinusCosMax = sin2Max / (1.0 + cosMax);
+        float v = u.x * oneMinusCosMax;  // 1 − cos α
+        float cosA = 1.0 - v;
+        float sinA = sqrt(max(0.0, v * (2.0 - v)));
         float phi = 2.0 * PI * u.y;
         vec3 w = toC / d;
         vec3 a = abs(w.x) > 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
@@ -104,9 +110,13 @@ LightSample sampleLight(uint i, uint lightCount, vec3 background, vec3 x, vec2 u
         vec3 tv = cross(w, tu);
         s.wi = normalize(cosA * w + sinA * (cos(phi) * tu + sin(phi) * tv));
         s.dist = sphereHit(x, s.wi, p, l.radius);
-        if (s.dist == NO_ROOT) return s;
+        if (s.dist == NO_ROOT) {
+            // A direction on the rim of the cone grazes the sphere: its tangent point.
+            vec3 oc = x - p;
+            s.dist = max(-dot(oc, s.wi), 0.0);
+        }
         s.radiance = v3(l.color);
-        s.pdf = 1.0 / (2.0 * PI * (1.0 - cosMax));
+        s.pdf = 1.0 / (2.0 * PI * oneMinusCosMax);
         s.valid = true;
     } else if (l.kind == LIGHT_RECT) {
         vec3 eu = v3(l.edgeU), ev = v3(l.edgeV);
@@ -125,18 +135,22 @@ LightSample sampleLight(uint i, uint lightCount, vec3 background, vec3 x, vec2 u
     return s;
 }
 
-// Solid-angle density with which sampleLight(i) picks wi from x (area lights
-// and the environment; 0 for delta lights).
-float lightPdf(uint i, uint lightCount, vec3 x, vec3 wi) {
-    if (i == lightCount) return 1.0 / (4.0 * PI);
-    Light l = lights[i];
+// Solid-angle density with which sampleLight(l) picks wi from x (area
+// lights; 0 for delta lights).
+float lightPdf(Light l, vec3 x, vec3 wi) {
     vec3 p = v3(l.position);
     if (l.kind == LIGHT_SPHERE) {
         vec3 toC = p - x;
         float d2 = dot(toC, toC);
         if (d2 <= l.radius * l.radius) return 0.0;
-        float cosMax = sqrt(max(0.0, 1.0 - (l.radius * l.radius) / d2));
-        return dot(wi, toC) >= cosMax * sqrt(d2) ? 1.0 / (2.0 * PI * (1.0 - cosMax)) : 0.0;
+        float sin2Max = (l.radius * l.radius) / d2;
+        float cosMax = sqrt(max(0.0, 1.0 - sin2Max));
+        // Inside the cone when the ray's line passes within the radius of the
+        // centre, in front: |wi × toC| <= r (precise in f32 even for tiny cones,
+        // where cos θmax rounds to 1).
+        vec3 c = cross(wi, toC);
+        bool inside = dot(wi, toC) > 0.0 && dot(c, c) <= l.radius * l.radius;
+        return inside ? 1.0 / (2.0 * PI * (sin2Max / (1.0 + cosMax))) : 0.0;
     }
     if (l.kind == LIGHT_RECT) {
         float t = rectHit(x, wi, l);
@@ -148,22 +162,12 @@ float lightPdf(uint i, uint lightCount, vec3 x, vec3 wi) {
     return 0.0;
 }
 
-// The first area light (sphere or rect) that o + t d meets before tmax:
-// its index (or lightCount when none) and distance.
-uint firstLightHit(uint lightCount, vec3 o, vec3 d, float tmax, out float tHit) {
-    uint which = lightCount;
-    tHit = tmax;
-    for (uint i = 0; i < lightCount; ++i) {
-        Light l = lights[i];
-        float t = NO_ROOT;
-        if (l.kind == LIGHT_SPHERE) t = sphereHit(o, d, v3(l.position), l.radius);
-        else if (l.kind == LIGHT_RECT) t = rectHit(o, d, l);
-        if (t < tHit) {
-            tHit = t;
-            which = i;
-        }
-    }
-    return which;
+// Distance along o + t d (d unit) to the emitting side of an area light, or
+// NO_ROOT (also for point and directional lights).
+float lightHit(Light l, vec3 o, vec3 d) {
+    if (l.kind == LIGHT_SPHERE) return sphereHit(o, d, v3(l.position), l.radius);
+    if (l.kind == LIGHT_RECT) return rectHit(o, d, l);
+    return NO_ROOT;
 }
 
 #endif

@@ -13,6 +13,7 @@
 layout(local_size_x = RENDER_GROUP, local_size_y = RENDER_GROUP) in;
 
 layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials { Material materials[]; };
+layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
 
 // Camera basis: ray direction = forward + x right + y up, x and y in [-1, 1].
 layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
@@ -124,6 +125,31 @@ vec3 offsetOrigin(vec3 p, vec3 n, vec3 dir) {
 
 bool environmentLit() { return any(greaterThan(frame.background, vec3(0.0))); }
 
+// Light index `frame.lightCount` stands for the uniform environment (the
+// background radiance) when it is not black.
+LightSample sampleLightOrEnvironment(uint i, vec3 x, vec2 u) {
+    return i == frame.lightCount ? sampleEnvironment(frame.background, u) : sampleLight(lights[i], x, u);
+}
+
+float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
+    return i == frame.lightCount ? 1.0 / (4.0 * PI) : lightPdf(lights[i], x, wi);
+}
+
+// The first area light that o + t d meets before tmax: its index (or
+// frame.lightCount when none) and distance.
+uint firstLightHit(vec3 o, vec3 d, float tmax, out float tHit) {
+    uint which = frame.lightCount;
+    tHit = tmax;
+    for (uint i = 0; i < frame.lightCount; ++i) {
+        float t = lightHit(lights[i], o, d);
+        if (t < tHit) {
+            tHit = t;
+            which = i;
+        }
+    }
+    return which;
+}
+
 // Number of light-sampling choices: the lights, plus the environment.
 uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
 
@@ -139,7 +165,7 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, in
     // of the shading normal, the only side a non-delta material reflects to),
     // so that the light's distance is measured from where the ray starts.
     vec3 origin = offsetOrigin(p, ng, frameW[2]);
-    LightSample ls = sampleLight(i, frame.lightCount, frame.background, origin, rand2(rng));
+    LightSample ls = sampleLightOrEnvironment(i, origin, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     vec3 wiLocal = transpose(frameW) * ls.wi;
     vec3 f = bsdfEval(mat, wo, wiLocal);
@@ -148,7 +174,7 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, in
     // Area lights may hide each other: a sphere or rect light in front blocks this one.
     if (i < frame.lightCount) {
         float tl;
-        uint first = firstLightHit(frame.lightCount, origin, ls.wi, ls.dist * (1.0 - 1e-4), tl);
+        uint first = firstLightHit(origin, ls.wi, ls.dist * (1.0 - 1e-4), tl);
         if (first != frame.lightCount) return vec3(0.0);
     }
     vec3 contribution = f * abs(wiLocal.z) * ls.radiance / select;
@@ -167,14 +193,13 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
     for (uint bounce = 0u; bounce < frame.maxDepth; ++bounce) {
         SceneHit h = traceScene(o, d, 0.0, 1e30);
         float tl;
-        uint lightHit = firstLightHit(frame.lightCount, o, d, h.object == NO_HIT ? 1e30 : h.t, tl);
-        if (lightHit != frame.lightCount || h.object == NO_HIT) {
+        uint which = firstLightHit(o, d, h.object == NO_HIT ? 1e30 : h.t, tl);
+        if (which != frame.lightCount || h.object == NO_HIT) {
             // An emitter: a sphere or rect light, or the environment.
-            uint which = lightHit != frame.lightCount ? lightHit : frame.lightCount;
             vec3 le = which != frame.lightCount ? v3(lights[which].color) : frame.background;
             float w = 1.0;
             if (lastPdf > 0.0 && (which != frame.lightCount || environmentLit())) {
-                w = powerHeuristic(lastPdf, lightPdf(which, frame.lightCount, lastPoint, d) / float(choices));
+                w = powerHeuristic(lastPdf, lightOrEnvironmentPdf(which, lastPoint, d) / float(choices));
             }
             radiance += throughput * le * w;
             break;

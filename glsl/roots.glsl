@@ -13,7 +13,7 @@
 #ifndef ROOTS_GLSL
 #define ROOTS_GLSL
 
-const float NO_ROOT = 3.402823e38;
+#include "common.glsl"
 
 // Deepest halving: intervals of 2^-14 of the piece.
 const uint MAX_LEVEL = 14u;

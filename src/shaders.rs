@@ -11,6 +11,12 @@ pub fn render() -> Vec<u32> {
     words(include_bytes!(concat!(env!("OUT_DIR"), "/render.comp.spv")))
 }
 
+/// `glsl/twins.comp`: BSDF and light sampling routines on given inputs, for
+/// the test that compares them with their CPU twins (`sampling`).
+pub fn twins() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/twins.comp.spv")))
+}
+
 /// `glsl/probe.comp`: closest hits of a list of rays.
 pub fn probe() -> Vec<u32> {
     words(include_bytes!(concat!(env!("OUT_DIR"), "/probe.comp.spv")))

@@ -8,6 +8,7 @@ pub mod poly;
 pub mod quadric;
 pub mod reference;
 pub mod scatter;
+pub mod uv;
 
 pub use object::{Cell, CellParams, FunctionalObject, GeometryError, Perturbation};
 pub use quadric::Quadric;

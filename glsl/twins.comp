@@ -1,0 +1,68 @@
+#version 460
+// Runs the GLSL sampling routines (bsdf.glsl, lights.glsl) on inputs given
+// by the host, so that tests/sampling_gpu.rs can compare them with their f64
+// CPU twins (src/sampling/).
+#extension GL_EXT_scalar_block_layout : require
+
+#include "lights.glsl"
+
+layout(local_size_x = 64) in;
+
+const uint OP_BSDF = 0u;
+const uint OP_LIGHT = 1u;
+
+struct TwinCase {
+    uint op;
+    Material mat;
+    Light light;
+    float wo[3];   // BSDF: outgoing direction (local frame)
+    float wi[3];   // BSDF: direction for eval/pdf; light: direction for lightPdf
+    float u[3];    // random numbers
+    float x[3];    // light: shading point
+};
+
+struct TwinResult {
+    float wi[3];
+    float weight[3];   // BSDF: sample weight; light: emitted radiance
+    float pdf;         // 0 for delta
+    uint valid;
+    float eval[3];     // BSDF: f(wo, wi)
+    float pdfOf;       // BSDF: pdf(wo, wi); light: lightPdf(x, wi)
+    float dist;        // light: distance to the light
+};
+
+layout(set = 0, binding = 0, scalar) readonly buffer Cases { TwinCase cases[]; };
+layout(set = 0, binding = 1, scalar) writeonly buffer Results { TwinResult results[]; };
+layout(push_constant, scalar) uniform Push { uint count; } pc;
+
+float[3] f3(vec3 v) { return float[3](v.x, v.y, v.z); }
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= pc.count) return;
+    TwinCase c = cases[i];
+    TwinResult r;
+    r.eval = f3(vec3(0.0));
+    r.pdfOf = 0.0;
+    r.dist = 0.0;
+    if (c.op == OP_BSDF) {
+        vec3 wo = v3(c.wo), wi = v3(c.wi);
+        BsdfSample s = bsdfSample(c.mat, wo, v3(c.u));
+        r.wi = f3(s.wi);
+        r.weight = f3(s.weight);
+        r.pdf = s.pdf;
+        r.valid = s.valid ? 1u : 0u;
+        r.eval = f3(bsdfEval(c.mat, wo, wi));
+        r.pdfOf = bsdfPdf(c.mat, wo, wi);
+    } else {
+        vec3 x = v3(c.x);
+        LightSample s = sampleLight(c.light, x, vec2(c.u[0], c.u[1]));
+        r.wi = f3(s.wi);
+        r.weight = f3(s.radiance);
+        r.pdf = s.pdf;
+        r.valid = s.valid ? 1u : 0u;
+        r.dist = s.dist;
+        r.pdfOf = lightPdf(c.light, x, v3(c.wi));
+    }
+    results[i] = r;
+}

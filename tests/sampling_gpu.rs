@@ -1,0 +1,333 @@
+//! The GLSL sampling routines (glsl/bsdf.glsl, glsl/lights.glsl, run by
+//! glsl/twins.comp) against their f64 CPU twins (src/sampling/), which the
+//! chi-square tests (tests/sampling_chi2.rs) check against their pdfs. Same
+//! inputs on both sides; the outputs must agree within f32 precision:
+//! directions within `DIR_TOL`, weights, radiance and densities within
+//! `REL_TOL` relative. Inputs within `EDGE` of a decision boundary (the
+//! dielectric's reflect/refract choice at u = F, a direction on a lobe's or
+//! a cone's rim, visible normals from u1 within `VNDF_RIM` of 1, where
+//! sqrt(1 − r²) cancels in f32) may go either way and are counted, not
+//! compared; their share must stay below `MAX_EDGE_SHARE`.
+
+mod common;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Vec3};
+use quadray::passes::gpu::{GpuLight, GpuMaterial};
+use quadray::sampling::{self, Bsdf};
+use quadray::scene::{ConductorFresnel, Light, Material, MaterialKind};
+use quadray::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, MemoryLocation};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+const DIR_TOL: f64 = 2e-4;
+const REL_TOL: f64 = 2e-3;
+const EDGE: f64 = 1e-4;
+const MAX_EDGE_SHARE: f64 = 0.002;
+const VNDF_RIM: f64 = 1e-3;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct TwinCase {
+    op: u32,
+    mat: GpuMaterial,
+    light: GpuLight,
+    wo: [f32; 3],
+    wi: [f32; 3],
+    u: [f32; 3],
+    x: [f32; 3],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+struct TwinResult {
+    wi: [f32; 3],
+    weight: [f32; 3],
+    pdf: f32,
+    valid: u32,
+    eval: [f32; 3],
+    pdf_of: f32,
+    dist: f32,
+}
+
+const _: () = assert!(std::mem::size_of::<TwinCase>() == 4 + 84 + 56 + 48);
+const _: () = assert!(std::mem::size_of::<TwinResult>() == 52);
+
+fn run_twins(cases: &[TwinCase]) -> Vec<TwinResult> {
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let results = {
+        let device = &ctx.device;
+        let pipeline = ComputePipeline::new(
+            device,
+            &quadray::shaders::twins(),
+            &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+            4,
+            &[],
+        )
+        .unwrap();
+        let input = Buffer::with_data(device, "twin cases", cases, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
+        let output = Buffer::new(
+            device,
+            "twin results",
+            (cases.len() * std::mem::size_of::<TwinResult>()) as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        )
+        .unwrap();
+        pipeline.bind(&[Binding::Buffer(&input), Binding::Buffer(&output)]);
+        let mut cmds = Commands::new(device).unwrap();
+        let count = cases.len() as u32;
+        cmds.run(|_, cmd| pipeline.dispatch(cmd, bytemuck::bytes_of(&count), [count.div_ceil(64), 1, 1])).unwrap();
+        let mut r: Vec<TwinResult> = output.read();
+        r.truncate(cases.len());
+        r
+    };
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+    results
+}
+
+fn d3(a: [f32; 3]) -> DVec3 {
+    DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / a.abs().max(b.abs()).max(1e-6)
+}
+
+fn rel3(a: DVec3, b: DVec3) -> f64 {
+    (a - b).abs().max_element() / a.abs().max(b.abs()).max_element().max(1e-6)
+}
+
+fn random_materials() -> Vec<Material> {
+    let mut out = vec![Material::diffuse("diffuse", Vec3::new(0.8, 0.5, 0.2))];
+    for &r in &[0.05f32, 0.2, 0.5, 0.8, 1.0, 0.0] {
+        for fresnel in [
+            ConductorFresnel::Schlick { f0: Vec3::new(0.95, 0.64, 0.54) },
+            ConductorFresnel::Complex { eta: Vec3::new(0.18, 0.42, 1.37), k: Vec3::new(3.42, 2.35, 1.77) },
+        ] {
+            out.push(Material {
+                kind: MaterialKind::Conductor { roughness: r, fresnel },
+                ..Material::diffuse("conductor", Vec3::ONE)
+            });
+        }
+    }
+    out.push(Material { kind: MaterialKind::Mirror, ..Material::diffuse("mirror", Vec3::new(0.9, 0.8, 0.7)) });
+    for ior in [1.33f32, 1.5, 2.4] {
+        out.push(Material {
+            kind: MaterialKind::Dielectric { roughness: 0.0, ior },
+            ..Material::diffuse("glass", Vec3::ONE)
+        });
+    }
+    out
+}
+
+fn random_dir(rng: &mut Pcg64, upper: bool) -> DVec3 {
+    loop {
+        let v = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+        let l = v.length();
+        if l > 1e-3 && l <= 1.0 && (!upper || v.z > 1e-3) {
+            return v / l;
+        }
+    }
+}
+
+fn f3(v: DVec3) -> [f32; 3] {
+    v.as_vec3().to_array()
+}
+
+#[test]
+fn gpu_bsdf_sampling_matches_the_cpu_twin() {
+    let mut rng = Pcg64::seed_from_u64(5);
+    let materials = random_materials();
+    let mut cases = Vec::new();
+    let mut inputs = Vec::new();
+    for _ in 0..4000 {
+        for m in &materials {
+            let dielectric = matches!(m.kind, MaterialKind::Dielectric { .. });
+            let wo = random_dir(&mut rng, !dielectric);
+            let wi = random_dir(&mut rng, true);
+            let u = [rng.gen::<f32>(), rng.gen::<f32>(), rng.gen::<f32>()];
+            // Round the inputs to f32 first so both sides see the same numbers.
+            let (wo, wi) = (d3(f3(wo)), d3(f3(wi)));
+            cases.push(TwinCase {
+                op: 0,
+                mat: GpuMaterial::from(m),
+                light: GpuLight::default(),
+                wo: f3(wo),
+                wi: f3(wi),
+                u,
+                x: [0.0; 3],
+            });
+            inputs.push((m.clone(), wo, wi, u.map(|v| v as f64)));
+        }
+    }
+    let results = run_twins(&cases);
+    let (mut compared, mut edge, mut worst_dir, mut worst_weight, mut worst_pdf, mut worst_eval) =
+        (0, 0, 0f64, 0f64, 0f64, 0f64);
+    let mut failures = Vec::new();
+    for ((m, wo, wi, u), r) in inputs.iter().zip(&results) {
+        let bsdf = Bsdf::from_material(m);
+        // eval and pdf at a given pair.
+        let (e, p) = (bsdf.eval(*wo, *wi), bsdf.pdf(*wo, *wi));
+        worst_eval = worst_eval.max(rel3(e, d3(r.eval)));
+        worst_pdf = worst_pdf.max(rel(p, r.pdf_of as f64));
+        if rel3(e, d3(r.eval)) > REL_TOL || rel(p, r.pdf_of as f64) > REL_TOL {
+            failures.push(format!(
+                "{}: eval/pdf at wo={wo:?} wi={wi:?}: cpu {e:?} {p}, gpu {:?} {}",
+                m.name, r.eval, r.pdf_of
+            ));
+        }
+        // Sampling.
+        if matches!(m.kind, MaterialKind::Conductor { .. }) && 1.0 - u[0] < VNDF_RIM {
+            edge += 1;
+            continue;
+        }
+        if let MaterialKind::Dielectric { ior, .. } = m.kind {
+            let f = sampling::fresnel_dielectric(wo.z, ior as f64);
+            if (u[2] - f).abs() < EDGE {
+                edge += 1;
+                continue;
+            }
+        }
+        let cpu = bsdf.sample(*wo, u[0], u[1], u[2]);
+        match (cpu, r.valid != 0) {
+            (None, false) => compared += 1,
+            (Some(s), true) => {
+                compared += 1;
+                let dd = (s.wi - d3(r.wi)).length();
+                let dw = rel3(s.weight, d3(r.weight));
+                let dp = rel(s.pdf.unwrap_or(0.0), r.pdf as f64);
+                worst_dir = worst_dir.max(dd);
+                worst_weight = worst_weight.max(dw);
+                worst_pdf = worst_pdf.max(dp);
+                if dd > DIR_TOL || dw > REL_TOL || dp > REL_TOL {
+                    failures.push(format!("{}: sample wo={wo:?} u={u:?}: cpu {s:?}, gpu {r:?}", m.name));
+                }
+            }
+            (cpu, _) => {
+                // Validity differs: only acceptable right at a rim (wi.z ≈ 0).
+                let z = cpu.map_or(r.wi[2] as f64, |s| s.wi.z);
+                if z.abs() < 10.0 * EDGE {
+                    edge += 1;
+                } else {
+                    failures.push(format!("{}: validity wo={wo:?} u={u:?}: cpu {cpu:?}, gpu {r:?}", m.name));
+                }
+            }
+        }
+    }
+    let share = edge as f64 / inputs.len() as f64;
+    println!(
+        "BSDF twins: {} cases ({} materials), {compared} samples compared, {edge} at an edge ({:.4}%); worst: direction \
+         {worst_dir:.2e} (bound {DIR_TOL:e}), weight {worst_weight:.2e}, pdf {worst_pdf:.2e}, eval {worst_eval:.2e} \
+         (bound {REL_TOL:e} relative)",
+        inputs.len(),
+        materials.len(),
+        100.0 * share
+    );
+    for f in failures.iter().take(5) {
+        println!("  {f}");
+    }
+    assert!(failures.is_empty(), "{} disagreements", failures.len());
+    assert!(share <= MAX_EDGE_SHARE, "too many edge cases: {share}");
+}
+
+#[test]
+fn gpu_light_sampling_matches_the_cpu_twin() {
+    let mut rng = Pcg64::seed_from_u64(9);
+    let lights = [
+        Light::Sphere { centre: DVec3::new(0.5, 3.0, -1.0), radius: 0.6, radiance: Vec3::new(5.0, 4.0, 3.0) },
+        Light::Sphere { centre: DVec3::new(-2.0, 1.0, 4.0), radius: 0.01, radiance: Vec3::splat(100.0) },
+        Light::Rect {
+            corner: DVec3::new(-1.0, 2.0, -1.5),
+            edge_u: DVec3::new(2.0, 0.0, 0.5),
+            edge_v: DVec3::new(0.0, 0.3, 2.0),
+            radiance: Vec3::new(2.0, 3.0, 4.0),
+        },
+    ];
+    let mut cases = Vec::new();
+    let mut inputs = Vec::new();
+    for _ in 0..5000 {
+        for l in &lights {
+            let x = d3(f3(DVec3::new(rng.gen_range(-2.0..2.0), rng.gen_range(-1.0..0.5), rng.gen_range(-2.0..2.0))));
+            let u = [rng.gen::<f32>(), rng.gen::<f32>(), 0.0];
+            // A direction for the density: toward a random point near the light.
+            let target = match l {
+                Light::Sphere { centre, radius, .. } => *centre + random_dir(&mut rng, false) * radius * 1.2,
+                Light::Rect { corner, edge_u, edge_v, .. } => {
+                    *corner + *edge_u * rng.gen_range(-0.1..1.1) + *edge_v * rng.gen_range(-0.1..1.1)
+                }
+                _ => unreachable!(),
+            };
+            let wi = d3(f3((target - x).normalize()));
+            cases.push(TwinCase {
+                op: 1,
+                mat: GpuMaterial::default(),
+                light: GpuLight::from(l),
+                wo: [0.0; 3],
+                wi: f3(wi),
+                u,
+                x: f3(x),
+            });
+            inputs.push((l.clone(), x, wi, u.map(|v| v as f64)));
+        }
+    }
+    let results = run_twins(&cases);
+    let (mut compared, mut edge, mut worst_dir, mut worst_pdf, mut worst_dist) = (0, 0, 0f64, 0f64, 0f64);
+    let mut failures = Vec::new();
+    for ((l, x, wi, u), r) in inputs.iter().zip(&results) {
+        // The f32 direction is unit only to ~2e-8, which moves the rim of a
+        // tiny cone (1 - cos θmax ~ 1e-6) in a cos-based test: normalise it.
+        let wi = &wi.normalize();
+        let (cpu, pdf_of) = match *l {
+            Light::Sphere { centre, radius, radiance } => (
+                sampling::sample_sphere_light(*x, centre, radius, radiance.as_dvec3(), u[0], u[1]),
+                sampling::pdf_sphere_light(*x, centre, radius, *wi),
+            ),
+            Light::Rect { corner, edge_u, edge_v, radiance } => (
+                sampling::sample_rect_light(*x, corner, edge_u, edge_v, radiance.as_dvec3(), u[0], u[1]),
+                sampling::pdf_rect_light(*x, corner, edge_u, edge_v, *wi),
+            ),
+            _ => unreachable!(),
+        };
+        // The density at a given direction: 0 outside the light, so a
+        // direction on its rim may go either way.
+        if (pdf_of == 0.0) != (r.pdf_of == 0.0) {
+            edge += 1;
+        } else {
+            worst_pdf = worst_pdf.max(rel(pdf_of, r.pdf_of as f64));
+            if rel(pdf_of, r.pdf_of as f64) > REL_TOL {
+                failures.push(format!("{l:?}: pdf at x={x:?} wi={wi:?}: cpu {pdf_of}, gpu {}", r.pdf_of));
+            }
+        }
+        match (cpu, r.valid != 0) {
+            (None, false) => compared += 1,
+            (Some(s), true) => {
+                compared += 1;
+                let dd = (s.wi - d3(r.wi)).length();
+                let dp = rel(s.pdf.unwrap_or(0.0), r.pdf as f64);
+                let dl = rel(s.dist, r.dist as f64);
+                worst_dir = worst_dir.max(dd);
+                worst_pdf = worst_pdf.max(dp);
+                worst_dist = worst_dist.max(dl);
+                if dd > DIR_TOL || dp > REL_TOL || dl > REL_TOL || rel3(s.emitted, d3(r.weight)) > REL_TOL {
+                    failures.push(format!("{l:?}: sample x={x:?} u={u:?}: cpu {s:?}, gpu {r:?}"));
+                }
+            }
+            (cpu, _) => failures.push(format!("{l:?}: validity x={x:?} u={u:?}: cpu {cpu:?}, gpu {r:?}")),
+        }
+    }
+    let share = edge as f64 / inputs.len() as f64;
+    println!(
+        "light twins: {} cases, {compared} samples compared, {edge} densities on a rim ({:.4}%); worst: direction \
+         {worst_dir:.2e} (bound {DIR_TOL:e}), pdf {worst_pdf:.2e}, distance {worst_dist:.2e} (bound {REL_TOL:e})",
+        inputs.len(),
+        100.0 * share
+    );
+    for f in failures.iter().take(5) {
+        println!("  {f}");
+    }
+    assert!(failures.is_empty(), "{} disagreements", failures.len());
+    assert!(share <= MAX_EDGE_SHARE, "too many rim cases: {share}");
+}
