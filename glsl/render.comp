@@ -108,6 +108,10 @@ layout(push_constant, scalar) uniform Push {
     uint writeAov;
 } pc;
 
+// Specialisation constant for cost breakdowns (benchmark mode): SHADING_FULL
+// or SHADING_NONE (the first hit's albedo: no light sampling, no bounces).
+layout(constant_id = 1) const uint SHADING_MODE = SHADING_FULL;
+
 // Bounces after which Russian roulette may end a path.
 const uint RR_DEPTH = 3u;
 
@@ -207,6 +211,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
 
         vec3 ns;
         Material mat = surfaceAt(h, ns);
+        if (SHADING_MODE == SHADING_NONE) return v3(mat.albedo);
         vec3 p = o + h.t * d;
         radiance += throughput * v3(mat.emission);
         // Two-sided shading; dielectrics keep the outward normal to tell inside from outside.

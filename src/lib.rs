@@ -14,7 +14,7 @@ pub mod passes;
 pub mod sampling;
 pub mod scene;
 pub mod shader_interface;
-mod shaders;
+pub mod shaders;
 pub mod texture;
 pub mod vk;
 
@@ -53,5 +53,5 @@ pub fn render_scene(
     let mut cmds = vk::Commands::new(&ctx.device)?;
     let gpu = passes::GpuScene::new(&ctx.device, &mut cmds, scene, &geometry::CellParams::default())?;
     let im = &scene.image;
-    passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), progress)
+    passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), Default::default(), progress)
 }

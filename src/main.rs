@@ -55,6 +55,13 @@ struct RenderArgs {
     /// Print progress even when stderr is not a terminal.
     #[arg(long)]
     progress: bool,
+    /// Benchmark mode: after an untimed warm-up (lavapipe compiles shaders at
+    /// their first dispatch), time the render and variants of it with parts of
+    /// the work switched off (perturbation root finding, shading and
+    /// secondary rays, intersection), print samples per second for each, and
+    /// write the full render's outputs.
+    #[arg(long)]
+    bench: bool,
 }
 
 /// Which files `-o` asks for.
@@ -150,10 +157,14 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
-    let mut progress = ProgressLine::new(args.progress);
-    let out = quadray::render_scene(&ctx, &scene, &mut |d, t| progress.update(d, t));
-    progress.finish();
-    let out = out.context("render failed")?;
+    let out = if args.bench {
+        bench(&ctx, &scene)?
+    } else {
+        let mut progress = ProgressLine::new(args.progress);
+        let out = quadray::render_scene(&ctx, &scene, &mut |d, t| progress.update(d, t));
+        progress.finish();
+        out.context("render failed")?
+    };
     if counters.errors() > 0 {
         bail!("the validation layer reported {} error(s); no output written", counters.errors());
     }
@@ -183,6 +194,54 @@ fn render(args: RenderArgs) -> Result<()> {
         bail!("the validation layer reported {} error(s) at shutdown", counters.errors());
     }
     Ok(())
+}
+
+/// The benchmark mode of `render --bench`; returns the full render.
+fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray::passes::RenderOutput> {
+    use quadray::passes::{render, GpuScene, RenderVariant};
+    use quadray::shader_interface::{INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, SHADING_FULL, SHADING_NONE};
+    let device = &ctx.device;
+    let mut cmds = quadray::vk::Commands::new(device)?;
+    let gpu = GpuScene::new(device, &mut cmds, scene, &quadray::geometry::CellParams::default())?;
+    let im = &scene.image;
+    let variants = [
+        ("full render", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_FULL }),
+        ("perturbation root finding off", RenderVariant { intersect: INTERSECT_BASE, shading: SHADING_FULL }),
+        ("shading and secondary rays off", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_NONE }),
+        (
+            "traversal only (boxes are hits, no shading)",
+            RenderVariant { intersect: INTERSECT_BOXES, shading: SHADING_NONE },
+        ),
+    ];
+    eprintln!(
+        "benchmark: {}x{}, {} spp, max depth {}, {} objects ({} perturbations, {} cells) on {}",
+        im.width,
+        im.height,
+        im.spp,
+        im.max_depth,
+        scene.objects.len(),
+        gpu.stats.perturbations,
+        gpu.stats.cells,
+        device.name
+    );
+    let mut full = None;
+    let mut rows = Vec::new();
+    for (name, variant) in variants {
+        // Untimed warm-up: the shader variant compiles at its first dispatch.
+        render(device, &mut cmds, &gpu, scene, (8, 8, 1), variant, &mut |_, _| {})?;
+        let out = render(device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), variant, &mut |_, _| {})?;
+        let samples = im.width as f64 * im.height as f64 * im.spp as f64;
+        rows.push((name, out.seconds, samples / out.seconds));
+        if full.is_none() {
+            full = Some(out);
+        }
+    }
+    let full_seconds = rows[0].1;
+    eprintln!("{:<46} {:>9} {:>14} {:>12}", "variant", "seconds", "samples/s", "of full time");
+    for (name, seconds, rate) in &rows {
+        eprintln!("{name:<46} {seconds:>9.3} {rate:>14.0} {:>11.1}%", 100.0 * seconds / full_seconds);
+    }
+    Ok(full.expect("the full render"))
 }
 
 fn main() -> Result<()> {

@@ -71,3 +71,7 @@ pub const INTERSECT_FULL: u32 = 0;
 pub const INTERSECT_BOXES: u32 = 1;
 /// Intersection mode: perturbations ignored (base quadric only).
 pub const INTERSECT_BASE: u32 = 2;
+/// Shading mode: the path tracer (the renderer's mode).
+pub const SHADING_FULL: u32 = 0;
+/// Shading mode: the first hit's albedo only (benchmark breakdowns).
+pub const SHADING_NONE: u32 = 1;

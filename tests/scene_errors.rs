@@ -783,3 +783,207 @@ fn single_brackets_for_an_array_of_tables() {
         &["objects[0].perturbations", "write [[objects.perturbations]]"],
     );
 }
+
+/// A valid material prefix for map tests: the map line is line 6.
+fn map_scene(line: &str) -> String {
+    format!("{CAMERA}[[materials]]\nname = \"m\"\n{line}\n")
+}
+
+#[test]
+fn missing_texture_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    let text = map_scene("albedo_map = \"textures/missing.png\"");
+    std::fs::write(&scene, &text).unwrap();
+    let m = load_scene(&scene).unwrap_err().to_string();
+    let texture = dir.path().join("textures/missing.png");
+    let expected = format!(
+        "{}:6:14: materials[0].albedo_map: cannot load the albedo map: {}: no such file",
+        scene.display(),
+        texture.display()
+    );
+    assert_eq!(m.lines().next().unwrap(), expected, "{m}");
+    assert!(m.contains("6 | albedo_map = \"textures/missing.png\"\n  |              ^^^^^^^^^^^^^^^^^^^^^^"), "{m}");
+
+    // The table form points at its `file`.
+    let text = map_scene("displacement_map = { file = \"h.exr\", scale = 0.1 }");
+    let m = check("missing_table.toml", &text, 6, &["materials[0].displacement_map.file", "h.exr: no such file"]);
+    assert!(m.contains(":6:29:"), "{m}");
+}
+
+#[test]
+fn bad_texture_files() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("noise.png"), b"definitely not a PNG file").unwrap();
+    std::fs::write(dir.path().join("picture.bmp"), b"BM").unwrap();
+    image::GrayImage::from_pixel(2, 2, image::Luma([7])).save(dir.path().join("grey.png")).unwrap();
+    let scene = dir.path().join("s.toml");
+    for (line, needles) in [
+        ("albedo_map = \"noise.png\"", &["materials[0].albedo_map", "noise.png: not a valid PNG image"][..]),
+        ("albedo_map = \"picture.bmp\"", &["picture.bmp: unsupported texture format `.bmp`"][..]),
+        (
+            "normal_map = \"grey.png\"",
+            &["materials[0].normal_map: cannot load the normal map", "grey.png: a normal map needs 3"][..],
+        ),
+    ] {
+        std::fs::write(&scene, map_scene(line)).unwrap();
+        let m = load_scene(&scene).unwrap_err().to_string();
+        assert!(m.starts_with(&format!("{}:6:14: ", scene.display())), "{m}");
+        for n in needles {
+            assert!(m.contains(n), "expected `{n}` in\n{m}");
+        }
+    }
+}
+
+#[test]
+fn texture_files_load_relative_to_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("maps")).unwrap();
+    image::RgbImage::from_pixel(3, 3, image::Rgb([128, 128, 128])).save(dir.path().join("maps/a.png")).unwrap();
+    let scene = dir.path().join("s.toml");
+    let text = format!(
+        "{}[[materials]]\nname = \"n\"\ntype = \"conductor\"\nroughness_map = \"maps/a.png\"\nnormal_map = \"maps/a.png\"\n\
+         [[objects]]\nmaterial = \"m\"\nsphere = {{ radius = 1 }}\nuv = {{ mapping = \"planar\", u_axis = [1, 0, 0], v_axis = [0, 1, 0] }}\n",
+        map_scene("albedo_map = { file = \"maps/a.png\" }")
+    );
+    std::fs::write(&scene, text).unwrap();
+    let s = load_scene(&scene).unwrap_or_else(|e| panic!("{e}"));
+    // The colour map and the (shared) data maps.
+    assert_eq!(s.textures.len(), 2);
+    assert_eq!(s.materials[0].maps.albedo, Some(0));
+    assert_eq!((s.materials[1].maps.roughness, s.materials[1].maps.normal), (Some(1), Some(1)));
+    assert_eq!((s.textures[0].width, s.textures[0].height), (4, 4));
+    assert!((s.textures[0].levels[0][0][0] - 0.215_860_5).abs() < 1e-5);
+    assert!((s.textures[1].levels[0][0][0] - 128.0 / 255.0).abs() < 1e-5);
+}
+
+#[test]
+fn map_keys_must_fit_the_material() {
+    check(
+        "roughness_on_diffuse.toml",
+        &map_scene("roughness_map = \"r.png\""),
+        6,
+        &[
+            "materials[0].roughness_map",
+            "`roughness_map` does not apply to a diffuse material (the default type)",
+            "belongs to type = \"conductor\" or type = \"dielectric\"",
+        ],
+    );
+    check(
+        "roughness_on_mirror.toml",
+        &map_scene("type = \"mirror\"\nroughness_map = { checker = { size = 8, cells = 2, colors = [0.1, 0.5] } }"),
+        7,
+        &["materials[0].roughness_map", "does not apply to a mirror material"],
+    );
+    check(
+        "albedo_on_dielectric.toml",
+        &map_scene("type = \"dielectric\"\nalbedo_map = \"a.png\""),
+        7,
+        &[
+            "materials[0].albedo_map",
+            "does not apply to a dielectric material",
+            "type = \"diffuse\" or type = \"mirror\"",
+        ],
+    );
+    check(
+        "bumps_albedo.toml",
+        &map_scene("albedo_map = { bumps = { size = 8, count = 3 } }"),
+        6,
+        &["materials[0].albedo_map.bumps", "`bumps` does not apply to an albedo map; it takes `file` or `checker`"],
+    );
+}
+
+#[test]
+fn bad_map_values() {
+    check(
+        "negative_scale.toml",
+        &map_scene("displacement_map = { bumps = { size = 64, count = 5 }, scale = -0.02 }"),
+        6,
+        &["materials[0].displacement_map.scale", "must be positive (got -0.02)", ":6:64:"],
+    );
+    check(
+        "zero_scale.toml",
+        &map_scene("displacement_map = { file = \"h.png\", scale = 0 }"),
+        6,
+        &["materials[0].displacement_map.scale", "must be positive (got 0)"],
+    );
+    check(
+        "no_scale.toml",
+        &map_scene("displacement_map = \"h.png\""),
+        6,
+        &["materials[0].displacement_map", "needs a height scale", "scale = 0.02"],
+    );
+    check(
+        "npot_checker.toml",
+        &map_scene("albedo_map = { checker = { size = 1000, cells = 10, colors = [0, 1] } }"),
+        6,
+        &["materials[0].albedo_map.checker.size", "must be a power of two from 1 to 16384", "(got 1000)"],
+    );
+    check(
+        "typo_map.toml",
+        &map_scene("normal_map = { bumps = { size = 64, count = 5, strenght = 2 } }"),
+        6,
+        &["materials[0].normal_map.bumps.strenght", "unknown field `strenght`"],
+    );
+    check(
+        "bad_colour.toml",
+        &map_scene("albedo_map = { checker = { size = 64, cells = 8, colors = [[1, 1, 1], [0, 0, -1]] } }"),
+        6,
+        &["materials[0].albedo_map.checker.colors[1][2]", "must be between 0 and 1 (got -1)"],
+    );
+}
+
+/// An object's `uv` with a valid scene around it: the `uv` line is line 6.
+fn uv_scene(uv: &str) -> String {
+    format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\nuv = {uv}\n")
+}
+
+#[test]
+fn uv_errors() {
+    check(
+        "bad_mapping.toml",
+        &uv_scene("{ mapping = \"cubic\" }"),
+        6,
+        &["objects[0].uv.mapping", "unknown variant `cubic`", "`planar`, `spherical`, `cylindrical`"],
+    );
+    check(
+        "parallel_axes.toml",
+        &uv_scene("{ mapping = \"planar\", u_axis = [1, 0, 0], v_axis = [2, 0, 0] }"),
+        6,
+        &["objects[0].uv.v_axis", "u_axis and v_axis are parallel", ":6:57:"],
+    );
+    check(
+        "missing_axis.toml",
+        &uv_scene("{ mapping = \"planar\", v_axis = [0, 0, 1] }"),
+        6,
+        &["objects[0].uv.u_axis", "the required key `u_axis` of a planar mapping is missing"],
+    );
+    check(
+        "zero_axis.toml",
+        &uv_scene("{ mapping = \"planar\", u_axis = [1, 0, 0], v_axis = [0, 0, 0] }"),
+        6,
+        &["objects[0].uv.v_axis", "must not be zero"],
+    );
+    check(
+        "axis_on_sphere.toml",
+        &uv_scene("{ mapping = \"spherical\", u_axis = [1, 0, 0] }"),
+        6,
+        &["objects[0].uv.u_axis", "does not apply to the spherical mapping", "mapping = \"planar\""],
+    );
+    check("zero_uv_scale.toml", &uv_scene("{ scale = [0, 1] }"), 6, &["objects[0].uv.scale[0]", "must not be zero"]);
+}
+
+#[test]
+fn textured_example_scene() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/textured.toml");
+    let s = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!s.textures.is_empty());
+    assert!(s.materials.iter().any(|m| m.maps.albedo.is_some()));
+    assert!(s.materials.iter().any(|m| m.maps.normal.is_some()));
+    assert!(s.objects.iter().any(|o| matches!(o.uv.mapping, quadray::scene::UvMapping::Planar { .. })));
+    for t in &s.textures {
+        assert!(t.width.is_power_of_two() && t.height.is_power_of_two(), "{}", t.source);
+        assert_eq!(t.levels[0].len(), (t.width * t.height) as usize);
+        assert_eq!(t.levels.last().unwrap().len(), 1);
+    }
+}

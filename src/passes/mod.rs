@@ -7,5 +7,5 @@ pub mod render;
 pub mod scene_gpu;
 
 pub use probe::ProbePass;
-pub use render::{render, RenderOutput};
+pub use render::{render, RenderOutput, RenderVariant};
 pub use scene_gpu::{GeometryStats, GpuScene};

@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::gpu::{GpuAov, GpuFrame, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use crate::scene::Scene;
-use crate::shader_interface::{MAX_TEXTURES, RENDER_GROUP};
+use crate::shader_interface::{INTERSECT_FULL, MAX_TEXTURES, RENDER_GROUP, SHADING_FULL};
 use crate::vk::{
     full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation,
 };
@@ -36,6 +36,24 @@ pub struct RenderOutput {
 /// Progress of a render: (work done, total work), in tile-samples.
 pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
 
+/// Variants of the render shader that switch parts of the work off, to
+/// measure what bounds a render (the benchmark mode). `Default` renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderVariant {
+    /// `INTERSECT_FULL`, `INTERSECT_BASE` (perturbation root finding off) or
+    /// `INTERSECT_BOXES` (every candidate box is a hit: traversal only).
+    pub intersect: u32,
+    /// `SHADING_FULL` or `SHADING_NONE` (the first hit's albedo: no light
+    /// sampling, no shadow rays, no bounces).
+    pub shading: u32,
+}
+
+impl Default for RenderVariant {
+    fn default() -> Self {
+        Self { intersect: INTERSECT_FULL, shading: SHADING_FULL }
+    }
+}
+
 /// Renders `scene` at `width` x `height` with `spp` samples per pixel.
 pub fn render(
     device: &Arc<Device>,
@@ -43,6 +61,7 @@ pub fn render(
     gpu: &GpuScene,
     scene: &Scene,
     (width, height, spp): (u32, u32, u32),
+    variant: RenderVariant,
     progress: Progress<'_>,
 ) -> Result<RenderOutput, RenderError> {
     let pixels = width as u64 * height as u64;
@@ -85,8 +104,13 @@ pub fn render(
     let mut kinds = vec![BindingKind::AccelerationStructure];
     kinds.extend([BindingKind::StorageBuffer; 7]);
     kinds.extend([BindingKind::StorageImage, BindingKind::StorageBuffer, BindingKind::SampledImages(MAX_TEXTURES)]);
-    let pipeline =
-        ComputePipeline::new(device, &shaders::render(), &kinds, std::mem::size_of::<RenderPush>() as u32, &[])?;
+    let pipeline = ComputePipeline::new(
+        device,
+        &shaders::render(),
+        &kinds,
+        std::mem::size_of::<RenderPush>() as u32,
+        &[variant.intersect, variant.shading],
+    )?;
     let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
     pipeline.bind(&[
         tlas,

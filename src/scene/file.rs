@@ -24,16 +24,17 @@ use std::marker::PhantomData;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3};
-use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use glam::{DAffine3, DQuat, DVec2, DVec3, EulerRot, Vec3};
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
 use super::{
     Camera, ConductorFresnel, ImageSettings, Light, Material, MaterialKind, MaterialMaps, Scene, SceneObject,
-    UvSettings,
+    TextureImage, UvMapping, UvSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
+use crate::texture::{self, TextureKind, TextureUsage, MAX_TEXTURE_SIZE};
 
 /// The file name used in messages about [`DEFAULT_SCENE`].
 pub const DEFAULT_SCENE_NAME: &str = "<embedded default scene>";
@@ -53,6 +54,8 @@ pub const MAX_DEPTH: i64 = 64;
 pub const MAX_SCATTER_COUNT: i64 = 1_000_000;
 /// Name of the built-in material given to objects without a `material` key.
 pub const DEFAULT_MATERIAL_NAME: &str = "<default>";
+/// Largest accepted `count` of a generated `bumps` texture.
+pub const MAX_TEXTURE_BUMPS: i64 = 1_000_000;
 
 /// Why a scene could not be loaded. `Display` gives the whole message.
 #[derive(Debug, thiserror::Error)]
@@ -101,9 +104,12 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     parse_scene(&text, &path.display().to_string())
 }
 
-/// Parses a scene from TOML text; `file_name` is used in error messages.
+/// Parses a scene from TOML text; `file_name` is used in error messages, and
+/// relative texture paths are resolved against its parent folder (against the
+/// current directory for [`DEFAULT_SCENE_NAME`]).
 pub fn parse_scene(source: &str, file_name: &str) -> Result<Scene, SceneError> {
-    let src = Source { text: source, file: file_name };
+    let dir = if file_name == DEFAULT_SCENE_NAME { None } else { Path::new(file_name).parent() };
+    let src = Source { text: source, file: file_name, dir: dir.unwrap_or(Path::new("")) };
     let raw: RawScene =
         serde_path_to_error::deserialize(toml::Deserializer::new(source)).map_err(|e| src.toml_error(e))?;
     build_scene(&src, raw)
@@ -116,6 +122,8 @@ pub fn parse_scene(source: &str, file_name: &str) -> Result<Scene, SceneError> {
 struct Source<'a> {
     text: &'a str,
     file: &'a str,
+    /// The folder relative texture paths start from.
+    dir: &'a Path,
 }
 
 impl Source<'_> {
@@ -493,6 +501,166 @@ impl<'de> Deserialize<'de> for Coefficients {
     }
 }
 
+/// The side of a generated texture: a power of two from 1 to
+/// [`MAX_TEXTURE_SIZE`].
+#[derive(Clone, Copy, Debug)]
+struct TextureSize(u32);
+
+struct TextureSizeVisitor;
+
+impl<'de> Visitor<'de> for TextureSizeVisitor {
+    type Value = TextureSize;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "a power of two from 1 to {MAX_TEXTURE_SIZE}")
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<TextureSize, E> {
+        match u32::try_from(v) {
+            Ok(n) if n.is_power_of_two() && n <= MAX_TEXTURE_SIZE => Ok(TextureSize(n)),
+            _ => Err(E::custom(format!(
+                "must be a power of two from 1 to {MAX_TEXTURE_SIZE}, such as 256, 512 or 1024 (got {v})"
+            ))),
+        }
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<TextureSize, E> {
+        self.visit_i64(i64::try_from(v).unwrap_or(i64::MAX))
+    }
+}
+
+impl<'de> Deserialize<'de> for TextureSize {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TextureSizeVisitor)
+    }
+}
+
+/// An array of two numbers, each checked as a `T`.
+#[derive(Clone, Copy, Debug)]
+struct Pair<T>(DVec2, PhantomData<T>);
+
+struct PairVisitor<T>(PhantomData<T>);
+
+impl<'de, T: Number + Deserialize<'de>> Visitor<'de> for PairVisitor<T> {
+    type Value = Pair<T>;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("an array of 2 numbers")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+        read_numbers::<T, A, 2>(seq).map(|v| Pair(DVec2::from_array(v), PhantomData))
+    }
+}
+
+impl<'de, T: Number + Deserialize<'de>> Deserialize<'de> for Pair<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(PairVisitor::<T>(PhantomData))
+    }
+}
+
+/// A colour with components in [0, 1], or one number in [0, 1] for a grey.
+#[derive(Clone, Copy, Debug)]
+struct UnitColour(DVec3);
+
+struct UnitColourVisitor;
+
+impl<'de> Visitor<'de> for UnitColourVisitor {
+    type Value = UnitColour;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number in [0, 1] or an array of 3 numbers in [0, 1]")
+    }
+
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<UnitColour, E> {
+        UnitInterval::parse(v).map(|p| UnitColour(DVec3::splat(p.get()))).map_err(E::custom)
+    }
+
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<UnitColour, E> {
+        self.visit_f64(v as f64)
+    }
+
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<UnitColour, E> {
+        self.visit_f64(v as f64)
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<UnitColour, A::Error> {
+        read_numbers::<UnitInterval, A, 3>(seq).map(|v| UnitColour(DVec3::from_array(v)))
+    }
+}
+
+impl<'de> Deserialize<'de> for UnitColour {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(UnitColourVisitor)
+    }
+}
+
+/// Exactly two [`UnitColour`]s: the colours of a checkerboard.
+#[derive(Clone, Copy, Debug)]
+struct ColourPair([DVec3; 2]);
+
+struct ColourPairVisitor;
+
+impl<'de> Visitor<'de> for ColourPairVisitor {
+    type Value = ColourPair;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("an array of 2 colours, such as [[0.9, 0.9, 0.9], [0.1, 0.1, 0.1]]")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<ColourPair, A::Error> {
+        let mut out = [DVec3::ZERO; 2];
+        let mut n = 0;
+        while let Some(c) = seq.next_element::<UnitColour>()? {
+            if n < 2 {
+                out[n] = c.0;
+            }
+            n += 1;
+        }
+        if n != 2 {
+            return Err(de::Error::custom(format!("must be an array of 2 colours (got {n})")));
+        }
+        Ok(ColourPair(out))
+    }
+}
+
+impl<'de> Deserialize<'de> for ColourPair {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(ColourPairVisitor)
+    }
+}
+
+/// A material's texture map: a file path, or a table naming a file or a
+/// generator.
+enum RawMap {
+    Path(String),
+    Table(Box<RawMapTable>),
+}
+
+struct RawMapVisitor;
+
+impl<'de> Visitor<'de> for RawMapVisitor {
+    type Value = RawMap;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a file path such as \"textures/wood.png\" or a table such as { file = \"wood.png\" }")
+    }
+
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawMap, E> {
+        Ok(RawMap::Path(v.to_owned()))
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<RawMap, A::Error> {
+        RawMapTable::deserialize(de::value::MapAccessDeserializer::new(map)).map(|t| RawMap::Table(Box::new(t)))
+    }
+}
+
+impl<'de> Deserialize<'de> for RawMap {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(RawMapVisitor)
+    }
+}
+
 // ---------------------------------------------------------------------------
 // The raw tree
 // ---------------------------------------------------------------------------
@@ -553,10 +721,28 @@ impl MaterialType {
 
 /// The keys each material type accepts, in the order messages list them.
 const MATERIAL_KEYS: [(&str, &[&str]); 4] = [
-    ("diffuse", &["name", "type", "albedo", "emission"]),
-    ("conductor", &["name", "type", "roughness", "color", "eta", "k", "metal", "emission"]),
-    ("dielectric", &["name", "type", "ior", "roughness", "emission"]),
-    ("mirror", &["name", "type", "albedo", "emission"]),
+    ("diffuse", &["name", "type", "albedo", "emission", "albedo_map", "normal_map", "displacement_map"]),
+    (
+        "conductor",
+        &[
+            "name",
+            "type",
+            "roughness",
+            "color",
+            "eta",
+            "k",
+            "metal",
+            "emission",
+            "roughness_map",
+            "normal_map",
+            "displacement_map",
+        ],
+    ),
+    (
+        "dielectric",
+        &["name", "type", "ior", "roughness", "emission", "roughness_map", "normal_map", "displacement_map"],
+    ),
+    ("mirror", &["name", "type", "albedo", "emission", "albedo_map", "normal_map", "displacement_map"]),
 ];
 
 /// A named conductor whose complex index of refraction is built in.
@@ -610,6 +796,39 @@ struct RawMaterial {
     k: Option<Spanned<Triple<NonNegative>>>,
     metal: Option<Spanned<Metal>>,
     ior: Option<Spanned<Ior>>,
+    albedo_map: Option<Spanned<RawMap>>,
+    normal_map: Option<Spanned<RawMap>>,
+    roughness_map: Option<Spanned<RawMap>>,
+    displacement_map: Option<Spanned<RawMap>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a texture map table such as { file = \"wood.png\" }")]
+struct RawMapTable {
+    file: Option<Spanned<String>>,
+    checker: Option<Spanned<RawChecker>>,
+    bumps: Option<Spanned<RawBumps>>,
+    scale: Option<Spanned<Positive>>,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table such as { size = 1024, cells = 64, colors = [[0.9, 0.9, 0.9], [0.1, 0.1, 0.1]] }"
+)]
+struct RawChecker {
+    size: TextureSize,
+    cells: Spanned<Int<1, { MAX_TEXTURE_SIZE as i64 }>>,
+    colors: ColourPair,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table such as { size = 512, count = 200, seed = 3, strength = 4 }")]
+struct RawBumps {
+    size: TextureSize,
+    count: Int<1, MAX_TEXTURE_BUMPS>,
+    seed: Option<Seed>,
+    strength: Option<Spanned<Positive>>,
 }
 
 #[derive(Deserialize)]
@@ -633,6 +852,25 @@ struct RawObject {
     perturbations: Vec<Spanned<RawPerturbation>>,
     #[serde(default)]
     scatter: Vec<Spanned<RawScatter>>,
+    uv: Option<Spanned<RawUv>>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Debug)]
+#[serde(rename_all = "lowercase")]
+enum MappingName {
+    Planar,
+    Spherical,
+    Cylindrical,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table such as { mapping = \"spherical\", scale = [8, 4] }")]
+struct RawUv {
+    mapping: Option<MappingName>,
+    u_axis: Option<Spanned<Triple<Finite>>>,
+    v_axis: Option<Spanned<Triple<Finite>>>,
+    scale: Option<Pair<NonZero>>,
+    offset: Option<Pair<Finite>>,
 }
 
 #[derive(Deserialize)]
@@ -775,6 +1013,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
     let camera = build_camera(src, &raw.camera)?;
     let background = raw.background.map_or(Vec3::ZERO, |b| b.get().as_vec3());
 
+    let mut textures = TextureCache::default();
     let mut materials: Vec<Material> = Vec::with_capacity(raw.materials.len() + 1);
     let mut material_lines = Vec::with_capacity(raw.materials.len());
     for (i, raw_material) in raw.materials.iter().enumerate() {
@@ -793,7 +1032,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
             ));
         }
         material_lines.push(src.text[..span.start.min(src.text.len())].matches('\n').count() + 1);
-        materials.push(build_material(src, i, raw_material)?);
+        materials.push(build_material(src, i, raw_material, &mut textures)?);
     }
     let user_materials = materials.len();
 
@@ -829,7 +1068,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
 
     let lights = raw.lights.iter().enumerate().map(|(i, l)| build_light(src, i, l)).collect::<Result<Vec<_>, _>>()?;
 
-    Ok(Scene { image, camera, background, materials, objects, lights, textures: Vec::new() })
+    Ok(Scene { image, camera, background, materials, objects, lights, textures: textures.images })
 }
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {
@@ -1021,7 +1260,68 @@ fn build_object(src: &Source, i: usize, raw: &Spanned<RawObject>, material: usiz
         shape,
         transform,
         material,
-        uv: UvSettings::default(),
+        uv: o.uv.as_ref().map_or(Ok(UvSettings::default()), |uv| build_uv(src, i, uv))?,
+    })
+}
+
+/// The texture coordinates of objects[i].
+fn build_uv(src: &Source, i: usize, raw: &Spanned<RawUv>) -> Result<UvSettings, SceneError> {
+    let uv = raw.get_ref();
+    let table = format!("objects[{i}].uv");
+    let name = uv.mapping.unwrap_or(MappingName::Spherical);
+    let axes = [("u_axis", &uv.u_axis), ("v_axis", &uv.v_axis)];
+    let mapping = if name == MappingName::Planar {
+        let mut vectors: [(DVec3, Range<usize>); 2] = Default::default();
+        for ((key, axis), out) in axes.into_iter().zip(&mut vectors) {
+            let Some(axis) = axis else {
+                return Err(src.error(
+                    Some(raw.span()),
+                    format!("{table}.{key}"),
+                    format!(
+                        "the required key `{key}` of a planar mapping is missing; give both axes, e.g. \
+                         uv = {{ mapping = \"planar\", u_axis = [1, 0, 0], v_axis = [0, 0, 1] }}"
+                    ),
+                ));
+            };
+            let v = axis.get_ref().get();
+            if v == DVec3::ZERO {
+                return Err(src.error(Some(axis.span()), format!("{table}.{key}"), "must not be zero"));
+            }
+            *out = (v, axis.span());
+        }
+        let [(u_axis, _), (v_axis, v_span)] = vectors;
+        if u_axis.cross(v_axis).length() <= 1e-6 * u_axis.length() * v_axis.length() {
+            return Err(src.error(
+                Some(v_span),
+                format!("{table}.v_axis"),
+                "u_axis and v_axis are parallel, so the planar mapping is degenerate (u and v would vary \
+                 together); give two axes that span a plane",
+            ));
+        }
+        UvMapping::Planar { u_axis, v_axis }
+    } else {
+        if let Some((key, axis)) = axes.into_iter().find_map(|(k, a)| a.as_ref().map(|a| (k, a))) {
+            let mapping = if name == MappingName::Spherical { "spherical" } else { "cylindrical" };
+            let default_note = if uv.mapping.is_none() { " (the default mapping)" } else { "" };
+            return Err(src.error(
+                Some(axis.span()),
+                format!("{table}.{key}"),
+                format!(
+                    "`{key}` does not apply to the {mapping} mapping{default_note}; only mapping = \"planar\" \
+                     takes u_axis and v_axis"
+                ),
+            ));
+        }
+        if name == MappingName::Spherical {
+            UvMapping::Spherical
+        } else {
+            UvMapping::Cylindrical
+        }
+    };
+    Ok(UvSettings {
+        mapping,
+        scale: uv.scale.map_or(DVec2::ONE, |s| s.0),
+        offset: uv.offset.map_or(DVec2::ZERO, |o| o.0),
     })
 }
 
@@ -1115,7 +1415,12 @@ fn check_type_keys(
     ))
 }
 
-fn build_material(src: &Source, i: usize, raw: &Spanned<RawMaterial>) -> Result<Material, SceneError> {
+fn build_material(
+    src: &Source,
+    i: usize,
+    raw: &Spanned<RawMaterial>,
+    textures: &mut TextureCache,
+) -> Result<Material, SceneError> {
     let m = raw.get_ref();
     let table = format!("materials[{i}]");
     let kind = m.kind.as_ref().map_or(MaterialType::Diffuse, |t| *t.get_ref());
@@ -1135,13 +1440,18 @@ fn build_material(src: &Source, i: usize, raw: &Spanned<RawMaterial>) -> Result<
             ("k", span_of(&m.k)),
             ("metal", span_of(&m.metal)),
             ("ior", span_of(&m.ior)),
+            ("albedo_map", span_of(&m.albedo_map)),
+            ("normal_map", span_of(&m.normal_map)),
+            ("roughness_map", span_of(&m.roughness_map)),
+            ("displacement_map", span_of(&m.displacement_map)),
         ],
     )?;
     let albedo = |default: f32| m.albedo.as_ref().map_or(Vec3::splat(default), |a| a.get_ref().get().as_vec3());
     let roughness = |default: f32| m.roughness.as_ref().map_or(default, |r| r.get_ref().get() as f32);
     // Conductors and dielectrics have no albedo; theirs is a neutral 1.
     let (kind, albedo) = match kind {
-        MaterialType::Diffuse => (MaterialKind::Diffuse, albedo(0.8)),
+        // With a colour map the map alone sets the colour unless albedo is given.
+        MaterialType::Diffuse => (MaterialKind::Diffuse, albedo(if m.albedo_map.is_some() { 1.0 } else { 0.8 })),
         MaterialType::Mirror => (MaterialKind::Mirror, albedo(1.0)),
         MaterialType::Conductor => (
             MaterialKind::Conductor { roughness: roughness(0.3), fresnel: conductor_fresnel(src, &table, raw)? },
@@ -1160,8 +1470,229 @@ fn build_material(src: &Source, i: usize, raw: &Spanned<RawMaterial>) -> Result<
         kind,
         albedo,
         emission: m.emission.as_ref().map_or(Vec3::ZERO, |e| e.get_ref().get().as_vec3()),
-        maps: MaterialMaps::default(),
+        maps: build_maps(src, &table, m, textures)?,
     })
+}
+
+/// The scene's textures, each loaded or generated once: identical specs
+/// (the same resolved path, or the same generator and parameters) read the
+/// same way share one entry.
+#[derive(Default)]
+struct TextureCache {
+    images: Vec<TextureImage>,
+    /// Per image: its key, how it was read, and its colour channels.
+    keys: Vec<(String, TextureUsage, u32)>,
+}
+
+/// Where a map's texels come from.
+enum MapSource {
+    File { path: PathBuf },
+    Checker { size: u32, cells: u32, colors: [[f32; 3]; 2] },
+    Heights { size: u32, count: u32, seed: u32 },
+    Normals { size: u32, count: u32, seed: u32, strength: f32 },
+}
+
+impl MapSource {
+    /// The dedupe key: equal keys give equal textures.
+    fn key(&self) -> String {
+        match self {
+            Self::File { path } => format!("file {}", path.display()),
+            Self::Checker { size, cells, colors } => format!("checker {size} {cells} {colors:?}"),
+            Self::Heights { size, count, seed } => format!("heights {size} {count} {seed}"),
+            Self::Normals { size, count, seed, strength } => format!("normals {size} {count} {seed} {strength:?}"),
+        }
+    }
+}
+
+impl TextureCache {
+    /// The index of the texture for `source` read as a `kind` map, loading
+    /// or generating it on first use.
+    fn get(&mut self, source: &MapSource, kind: TextureKind) -> Result<usize, texture::TextureError> {
+        let (key, usage) = (source.key(), kind.usage());
+        if let Some(k) = self.keys.iter().position(|(k, u, _)| *k == key && *u == usage) {
+            if let MapSource::File { path } = source {
+                kind.check_channels(path, self.keys[k].2)?;
+            }
+            return Ok(k);
+        }
+        let (image, channels) = match *source {
+            MapSource::File { ref path } => {
+                let loaded = texture::load_texture_file(path, usage)?;
+                kind.check_channels(path, loaded.channels)?;
+                (loaded.image, loaded.channels)
+            }
+            MapSource::Checker { size, cells, colors: [a, b] } => (texture::checker(size, cells, a, b), 3),
+            MapSource::Heights { size, count, seed } => (texture::bump_heights(size, count, seed), 1),
+            MapSource::Normals { size, count, seed, strength } => {
+                (texture::normals_from_heights(&texture::bump_heights(size, count, seed), strength), 3)
+            }
+        };
+        self.images.push(image);
+        self.keys.push((key, usage, channels));
+        Ok(self.images.len() - 1)
+    }
+}
+
+/// The texture maps of a material (`table` is its field path).
+fn build_maps(
+    src: &Source,
+    table: &str,
+    m: &RawMaterial,
+    textures: &mut TextureCache,
+) -> Result<MaterialMaps, SceneError> {
+    let mut maps = MaterialMaps::default();
+    let mut one = |key: &str, kind: TextureKind, raw: &Option<Spanned<RawMap>>| match raw {
+        Some(raw) => build_map(src, &format!("{table}.{key}"), kind, raw, textures).map(Some),
+        None => Ok(None),
+    };
+    maps.albedo = one("albedo_map", TextureKind::Albedo, &m.albedo_map)?.map(|(k, _)| k);
+    maps.normal = one("normal_map", TextureKind::Normal, &m.normal_map)?.map(|(k, _)| k);
+    maps.roughness = one("roughness_map", TextureKind::Roughness, &m.roughness_map)?.map(|(k, _)| k);
+    maps.displacement = one("displacement_map", TextureKind::Displacement, &m.displacement_map)?
+        .map(|(k, scale)| (k, scale.expect("a displacement map has a scale")));
+    Ok(maps)
+}
+
+/// "a normal map", "an albedo map".
+fn with_article(noun: &str) -> String {
+    let article = if noun.starts_with(['a', 'e', 'i', 'o', 'u']) { "an" } else { "a" };
+    format!("{article} {noun}")
+}
+
+/// One texture map at `field` (e.g. `materials[2].albedo_map`): its texture
+/// index, and the height scale of a displacement map.
+fn build_map(
+    src: &Source,
+    field: &str,
+    kind: TextureKind,
+    raw: &Spanned<RawMap>,
+    textures: &mut TextureCache,
+) -> Result<(usize, Option<f32>), SceneError> {
+    let generator = match kind {
+        TextureKind::Albedo | TextureKind::Roughness => "checker",
+        TextureKind::Normal | TextureKind::Displacement => "bumps",
+    };
+    let empty_path =
+        |span: Range<usize>, field: &str| src.error(Some(span), field, "the texture path must not be empty");
+    // (source, span and field path for load errors, height scale)
+    let (source, span, source_field, scale) = match raw.get_ref() {
+        RawMap::Path(path) => {
+            if kind == TextureKind::Displacement {
+                return Err(src.error(
+                    Some(raw.span()),
+                    field,
+                    format!(
+                        "a displacement map needs a height scale; write a table: \
+                         displacement_map = {{ file = {path:?}, scale = 0.02 }}"
+                    ),
+                ));
+            }
+            if path.is_empty() {
+                return Err(empty_path(raw.span(), field));
+            }
+            (MapSource::File { path: src.dir.join(path) }, raw.span(), field.to_owned(), None)
+        }
+        RawMap::Table(t) => {
+            let mut present: Vec<(&str, Range<usize>)> = [
+                span_of(&t.file).map(|s| ("file", s)),
+                span_of(&t.checker).map(|s| ("checker", s)),
+                span_of(&t.bumps).map(|s| ("bumps", s)),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            present.sort_by_key(|(_, span)| span.start);
+            if let Some((key, span)) = present.iter().find(|(key, _)| *key != "file" && *key != generator) {
+                return Err(src.error(
+                    Some(span.clone()),
+                    format!("{field}.{key}"),
+                    format!(
+                        "`{key}` does not apply to {}; it takes `file` or `{generator}`",
+                        with_article(kind.name())
+                    ),
+                ));
+            }
+            match present.as_slice() {
+                [] => {
+                    return Err(src.error(
+                        Some(raw.span()),
+                        field,
+                        format!("the {} needs exactly one of `file` and `{generator}`; found neither", kind.name()),
+                    ))
+                }
+                [_, (key, span), ..] => {
+                    return Err(src.error(
+                        Some(span.clone()),
+                        format!("{field}.{key}"),
+                        format!("the {} needs exactly one of `file` and `{generator}`; found both", kind.name()),
+                    ))
+                }
+                [_] => {}
+            }
+            let scale = match (&t.scale, kind) {
+                (Some(s), TextureKind::Displacement) => Some(s.get_ref().get() as f32),
+                (None, TextureKind::Displacement) => {
+                    return Err(src.error(
+                        Some(raw.span()),
+                        format!("{field}.scale"),
+                        "the required key `scale` of a displacement map is missing: the height of a texel \
+                         value of 1, in object units, e.g. scale = 0.02",
+                    ))
+                }
+                (Some(s), _) => {
+                    return Err(src.error(
+                        Some(s.span()),
+                        format!("{field}.scale"),
+                        format!("`scale` applies only to a displacement map, not to {}", with_article(kind.name())),
+                    ))
+                }
+                (None, _) => None,
+            };
+            if let Some(file) = &t.file {
+                if file.get_ref().is_empty() {
+                    return Err(empty_path(file.span(), &format!("{field}.file")));
+                }
+                (MapSource::File { path: src.dir.join(file.get_ref()) }, file.span(), format!("{field}.file"), scale)
+            } else if let Some(c) = &t.checker {
+                let c = c.get_ref();
+                let (size, cells) = (c.size.0, c.cells.get_ref().get() as u32);
+                if cells > size {
+                    return Err(src.error(
+                        Some(c.cells.span()),
+                        format!("{field}.checker.cells"),
+                        format!("must be at most the texture size {size} (got {cells})"),
+                    ));
+                }
+                let colors = c.colors.0.map(|v| v.as_vec3().to_array());
+                (MapSource::Checker { size, cells, colors }, raw.span(), field.to_owned(), scale)
+            } else if let Some(b) = &t.bumps {
+                let b = b.get_ref();
+                let (size, count, seed) = (b.size.0, b.count.get() as u32, b.seed.map_or(0, |s| s.get() as u32));
+                let source = match (kind, &b.strength) {
+                    (TextureKind::Normal, strength) => {
+                        let strength = strength.as_ref().map_or(1.0, |s| s.get_ref().get() as f32);
+                        MapSource::Normals { size, count, seed, strength }
+                    }
+                    (_, Some(strength)) => {
+                        return Err(src.error(
+                            Some(strength.span()),
+                            format!("{field}.bumps.strength"),
+                            "`strength` applies only to the bumps of a normal map; a displacement map's height \
+                             is set by its `scale`",
+                        ))
+                    }
+                    (_, None) => MapSource::Heights { size, count, seed },
+                };
+                (source, raw.span(), field.to_owned(), scale)
+            } else {
+                unreachable!("exactly one source is present")
+            }
+        }
+    };
+    let index = textures
+        .get(&source, kind)
+        .map_err(|e| src.error(Some(span), source_field, format!("cannot load the {}: {e}", kind.name())))?;
+    Ok((index, scale))
 }
 
 /// The Fresnel term of a conductor from its one of `color`, `eta` with `k`,
@@ -1783,6 +2314,208 @@ mod tests {
         for o in &s.objects {
             assert!(o.shape.bounds().is_ok(), "{}", o.name);
         }
+    }
+
+    #[test]
+    fn generated_maps_and_deduplication() {
+        let s = parse(
+            "[[materials]]\nname = \"a\"\nalbedo_map = { checker = { size = 16, cells = 4, colors = [[0.9, 0.9, 0.9], 0.1] } }\n\
+             normal_map = { bumps = { size = 32, count = 10, seed = 3, strength = 4.0 } }\n\
+             [[materials]]\nname = \"b\"\ntype = \"mirror\"\n\
+             albedo_map = { checker = { size = 16, cells = 4, colors = [[0.9, 0.9, 0.9], [0.1, 0.1, 0.1]] } }\n\
+             displacement_map = { bumps = { size = 32, count = 10, seed = 3 }, scale = 0.02 }\n\
+             [[materials]]\nname = \"c\"\ntype = \"conductor\"\n\
+             roughness_map = { checker = { size = 16, cells = 4, colors = [[0.9, 0.9, 0.9], 0.1] } }\n\
+             normal_map = { bumps = { size = 32, count = 10, seed = 3, strength = 4 } }\n\
+             displacement_map = { bumps = { size = 32, count = 10, seed = 3 }, scale = 0.5 }\n\
+             [[materials]]\nname = \"d\"\ntype = \"dielectric\"\n\
+             normal_map = { bumps = { size = 32, count = 10, seed = 4 } }\n",
+        );
+        let maps: Vec<&MaterialMaps> = s.materials.iter().map(|m| &m.maps).collect();
+        // a: checker 0, normals 1; b: the same checker, heights 2; c: the
+        // checker read as data is another texture (3), the same normals, the
+        // same heights with another scale; d: other normals (4).
+        assert_eq!(*maps[0], MaterialMaps { albedo: Some(0), normal: Some(1), roughness: None, displacement: None });
+        assert_eq!(
+            *maps[1],
+            MaterialMaps { albedo: Some(0), normal: None, roughness: None, displacement: Some((2, 0.02)) }
+        );
+        assert_eq!(
+            *maps[2],
+            MaterialMaps { albedo: None, normal: Some(1), roughness: Some(3), displacement: Some((2, 0.5)) }
+        );
+        assert_eq!(maps[3].normal, Some(4));
+        assert_eq!(s.textures.len(), 5);
+        // With a colour map, a diffuse albedo defaults to 1; without, to 0.8.
+        assert_eq!(s.materials[0].albedo, Vec3::ONE);
+        assert_eq!(
+            one_material(
+                "albedo_map = { checker = { size = 1, cells = 1, colors = [1, 1] } }\nalbedo = [0.5, 0.5, 0.5]"
+            )
+            .albedo,
+            Vec3::splat(0.5)
+        );
+        let checker = &s.textures[0];
+        assert_eq!((checker.width, checker.height, checker.levels.len()), (16, 16, 5));
+        assert_eq!(checker.levels[0][0], [0.9, 0.9, 0.9, 1.0]);
+        assert_eq!(checker.levels[0][4], [0.1, 0.1, 0.1, 1.0]);
+        assert_eq!(s.textures[3].levels[0], checker.levels[0]);
+        assert_eq!(s.textures[1], texture::normals_from_heights(&texture::bump_heights(32, 10, 3), 4.0));
+        assert_eq!(s.textures[2], texture::bump_heights(32, 10, 3));
+        assert_eq!(s.textures[4], texture::normals_from_heights(&texture::bump_heights(32, 10, 4), 1.0));
+        // No maps, no textures.
+        assert!(parse("[[materials]]\nname = \"m\"\n").textures.is_empty());
+    }
+
+    /// Writes an 8-bit PNG with `channels` channels (1 or 3) of value `v`.
+    fn write_png(path: &Path, channels: u8, v: u8) {
+        match channels {
+            1 => image::GrayImage::from_pixel(2, 2, image::Luma([v])).save(path).unwrap(),
+            _ => image::RgbImage::from_pixel(2, 2, image::Rgb([v, v, v])).save(path).unwrap(),
+        }
+    }
+
+    #[test]
+    fn texture_files_are_relative_to_the_scene_and_loaded_once() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("tex")).unwrap();
+        write_png(&dir.path().join("tex/grey.png"), 1, 128);
+        write_png(&dir.path().join("tex/rgb.png"), 3, 128);
+        let text = format!(
+            "{CAMERA}[[materials]]\nname = \"a\"\nalbedo_map = \"tex/grey.png\"\nnormal_map = \"tex/rgb.png\"\n\
+             [[materials]]\nname = \"b\"\nalbedo_map = {{ file = \"tex/grey.png\" }}\n\
+             displacement_map = {{ file = \"tex/rgb.png\", scale = 0.1 }}\n\
+             [[materials]]\nname = \"c\"\ntype = \"conductor\"\nroughness_map = \"tex/grey.png\"\n\
+             normal_map = \"{}\"\n",
+            dir.path().join("tex/rgb.png").display().to_string().replace('\\', "\\\\")
+        );
+        let scene_file = dir.path().join("scene.toml");
+        let s = parse_scene(&text, &scene_file.display().to_string()).unwrap_or_else(|e| panic!("{e}"));
+        let maps: Vec<&MaterialMaps> = s.materials.iter().map(|m| &m.maps).collect();
+        // grey as colour: 0; rgb as data: 1 (normal, displacement, and by
+        // absolute path); grey as data: 2.
+        assert_eq!((maps[0].albedo, maps[0].normal), (Some(0), Some(1)));
+        assert_eq!((maps[1].albedo, maps[1].displacement), (Some(0), Some((1, 0.1))));
+        assert_eq!((maps[2].roughness, maps[2].normal), (Some(2), Some(1)));
+        assert_eq!(s.textures.len(), 3);
+        assert!((s.textures[0].levels[0][0][0] - 0.215_860_5).abs() < 1e-6, "sRGB-decoded");
+        assert!((s.textures[1].levels[0][0][0] - 128.0 / 255.0).abs() < 1e-6, "as stored");
+        assert!((s.textures[2].levels[0][0][0] - 128.0 / 255.0).abs() < 1e-6, "as stored");
+        assert!(s.textures[0].source.ends_with("grey.png"));
+
+        // A grey image cached for a roughness map is still no normal map.
+        let text = format!(
+            "{CAMERA}[[materials]]\nname = \"c\"\ntype = \"conductor\"\nroughness_map = \"tex/grey.png\"\n\
+             normal_map = \"tex/grey.png\"\n"
+        );
+        let e = parse_scene(&text, &scene_file.display().to_string()).unwrap_err().to_string();
+        assert!(e.contains(":8:14: materials[0].normal_map: cannot load the normal map:"), "{e}");
+        assert!(e.contains("grey.png: a normal map needs 3 colour channels (RGB) but the image has 1"), "{e}");
+
+        // A missing file names the resolved path and the field.
+        let text = format!("{CAMERA}[[materials]]\nname = \"m\"\nalbedo_map = {{ file = \"tex/nope.png\" }}\n");
+        let e = parse_scene(&text, &scene_file.display().to_string()).unwrap_err().to_string();
+        let missing = dir.path().join("tex/nope.png").display().to_string();
+        assert!(e.contains(":6:23: materials[0].albedo_map.file: cannot load the albedo map: "), "{e}");
+        assert!(e.contains(&format!("{missing}: no such file")), "{e}");
+    }
+
+    #[test]
+    fn uv_settings() {
+        let s = parse(
+            "[[objects]]\nsphere = { radius = 1 }\n\
+             [[objects]]\nsphere = { radius = 1 }\nuv = { scale = [8, 4], offset = [0.5, -1] }\n\
+             [[objects]]\nsphere = { radius = 1 }\nuv = { mapping = \"planar\", u_axis = [1, 0, 0], v_axis = [0, 0, 2], scale = [2, -2] }\n\
+             [[objects]]\nsphere = { radius = 1 }\nuv = { mapping = \"cylindrical\", scale = [4, 1] }\n",
+        );
+        let uv: Vec<UvSettings> = s.objects.iter().map(|o| o.uv).collect();
+        assert_eq!(uv[0], UvSettings::default());
+        assert_eq!(uv[0], UvSettings { mapping: UvMapping::Spherical, scale: DVec2::ONE, offset: DVec2::ZERO });
+        assert_eq!(
+            uv[1],
+            UvSettings { mapping: UvMapping::Spherical, scale: DVec2::new(8.0, 4.0), offset: DVec2::new(0.5, -1.0) }
+        );
+        assert_eq!(uv[2].mapping, UvMapping::Planar { u_axis: DVec3::X, v_axis: DVec3::new(0.0, 0.0, 2.0) });
+        assert_eq!(uv[2].scale, DVec2::new(2.0, -2.0));
+        assert_eq!((uv[3].mapping, uv[3].scale), (UvMapping::Cylindrical, DVec2::new(4.0, 1.0)));
+    }
+
+    #[test]
+    fn uv_errors() {
+        let err = |uv: &str| {
+            let text = format!("{CAMERA}[[objects]]\nsphere = {{ radius = 1 }}\nuv = {uv}\n");
+            parse_scene(&text, "t.toml").unwrap_err().to_string()
+        };
+        let e = err("{ mapping = \"cubic\" }");
+        assert!(e.starts_with("t.toml:6:18: objects[0].uv.mapping: unknown variant `cubic`"), "{e}");
+        assert!(e.contains("`planar`, `spherical`, `cylindrical`"), "{e}");
+        let e = err("{ mapping = \"planar\", u_axis = [1, 0, 0] }");
+        assert!(e.starts_with("t.toml:6:6: objects[0].uv.v_axis: the required key `v_axis` of a planar"), "{e}");
+        let e = err("{ mapping = \"planar\", u_axis = [1, 0, 0], v_axis = [-2, 0, 0] }");
+        assert!(e.starts_with("t.toml:6:57: objects[0].uv.v_axis: u_axis and v_axis are parallel"), "{e}");
+        let e = err("{ mapping = \"planar\", u_axis = [0, 0, 0], v_axis = [1, 0, 0] }");
+        assert!(e.starts_with("t.toml:6:37: objects[0].uv.u_axis: must not be zero"), "{e}");
+        let e = err("{ u_axis = [1, 0, 0] }");
+        assert!(
+            e.contains("objects[0].uv.u_axis: `u_axis` does not apply to the spherical mapping (the default"),
+            "{e}"
+        );
+        let e = err("{ mapping = \"cylindrical\", v_axis = [1, 0, 0] }");
+        assert!(e.contains("objects[0].uv.v_axis: `v_axis` does not apply to the cylindrical mapping;"), "{e}");
+        let e = err("{ scale = [1, 0] }");
+        assert!(e.starts_with("t.toml:6:20: objects[0].uv.scale[1]: must not be zero"), "{e}");
+        let e = err("{ scale = [1, 2, 3] }");
+        assert!(e.contains("objects[0].uv.scale: must be an array of 2 numbers (got 3)"), "{e}");
+        let e = err("{ offset = [1, 2], scael = [1, 1] }");
+        assert!(e.contains("objects[0].uv.scael: unknown field `scael`"), "{e}");
+    }
+
+    #[test]
+    fn map_errors() {
+        let e = material_error("normal_map = { checker = { size = 4, cells = 2, colors = [0, 1] } }\n");
+        assert!(e.starts_with("t.toml:6:26: materials[0].normal_map.checker: `checker` does not apply"), "{e}");
+        assert!(e.contains("a normal map; it takes `file` or `bumps`"), "{e}");
+        let e =
+            material_error("albedo_map = { file = \"a.png\", checker = { size = 4, cells = 2, colors = [0, 1] } }\n");
+        assert!(
+            e.starts_with("t.toml:6:42: materials[0].albedo_map.checker: the albedo map needs exactly one of"),
+            "{e}"
+        );
+        assert!(e.contains("found both"), "{e}");
+        let e = material_error("albedo_map = {}\n");
+        assert!(e.contains(
+            "materials[0].albedo_map: the albedo map needs exactly one of `file` and `checker`; found neither"
+        ));
+        let e = material_error("albedo_map = { file = \"a.png\", scale = 2 }\n");
+        assert!(e.contains("materials[0].albedo_map.scale: `scale` applies only to a displacement map"), "{e}");
+        let e = material_error("displacement_map = \"h.png\"\n");
+        assert!(e.starts_with("t.toml:6:20: materials[0].displacement_map: a displacement map needs a height"), "{e}");
+        let e = material_error("displacement_map = { file = \"h.png\" }\n");
+        assert!(e.contains("materials[0].displacement_map.scale: the required key `scale`"), "{e}");
+        let e = material_error("displacement_map = { file = \"h.png\", scale = -0.1 }\n");
+        assert!(e.contains("materials[0].displacement_map.scale: must be positive (got -0.1)"), "{e}");
+        let e = material_error("displacement_map = { bumps = { size = 8, count = 1, strength = 2 }, scale = 1 }\n");
+        assert!(e.contains("materials[0].displacement_map.bumps.strength: `strength` applies only"), "{e}");
+        let e = material_error("albedo_map = { checker = { size = 100, cells = 2, colors = [0, 1] } }\n");
+        assert!(e.contains("materials[0].albedo_map.checker.size: must be a power of two from 1 to 16384"), "{e}");
+        let e = material_error("albedo_map = { checker = { size = 4, cells = 8, colors = [0, 1] } }\n");
+        assert!(e.contains("materials[0].albedo_map.checker.cells: must be at most the texture size 4 (got 8)"));
+        let e = material_error("albedo_map = { checker = { size = 4, cells = 2, colors = [0, 1, 1] } }\n");
+        assert!(e.contains("materials[0].albedo_map.checker.colors: must be an array of 2 colours (got 3)"), "{e}");
+        let e = material_error("albedo_map = { checker = { size = 4, cells = 2, colors = [0, [1, 2, 0]] } }\n");
+        assert!(e.contains("materials[0].albedo_map.checker.colors[1][1]: must be between 0 and 1 (got 2)"), "{e}");
+        let e = material_error("normal_map = { bumps = { size = 4, count = 0 } }\n");
+        assert!(e.contains("materials[0].normal_map.bumps.count: must be an integer from 1 to"), "{e}");
+        let e = material_error("normal_map = 3\n");
+        assert!(e.contains("materials[0].normal_map: invalid type: integer `3`, expected a file path"), "{e}");
+        let e = material_error("albedo_map = \"\"\n");
+        assert!(e.contains("materials[0].albedo_map: the texture path must not be empty"), "{e}");
+        let e = material_error("roughness_map = \"r.png\"\n");
+        assert!(e.contains("materials[0].roughness_map: `roughness_map` does not apply to a diffuse material"), "{e}");
+        assert!(e.contains("belongs to type = \"conductor\" or type = \"dielectric\""), "{e}");
+        let e = material_error("type = \"conductor\"\nalbedo_map = \"a.png\"\n");
+        assert!(e.contains("`albedo_map` does not apply to a conductor material"), "{e}");
+        assert!(e.contains("belongs to type = \"diffuse\" or type = \"mirror\""), "{e}");
     }
 
     #[test]
