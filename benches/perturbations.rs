@@ -44,6 +44,7 @@ fn sphere_scene(n: usize) -> Scene {
         }],
         lights: vec![],
         textures: vec![],
+        environment: None,
     }
 }
 

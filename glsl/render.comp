@@ -27,6 +27,10 @@ layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
     uint seed;
     uint lightCount;
     uint maxDepth;
+    uint envMap;      // texture index of the environment map, or NO_TEXTURE
+    uint envWidth;
+    uint envHeight;
+    float envScale;
 } frame;
 
 // rgb: summed radiance, a: sample count.
@@ -43,6 +47,87 @@ layout(set = 0, binding = BINDING_AOV, scalar) writeonly buffer Aovs { Aov aovs[
 layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTURES];
 
 vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index)], uv, 0.0); }
+
+// ---- The environment map --------------------------------------------------
+// Lat-long, piecewise constant per texel, importance-sampled by luminance ×
+// sin θ with the marginal and conditional CDFs built on the CPU
+// (src/sampling/envmap.rs, the f64 twin, documents the conventions).
+layout(set = 0, binding = BINDING_ENV_CDF, scalar) readonly buffer EnvCdf { float envCdf[]; };
+
+bool envMapped() { return frame.envMap != NO_TEXTURE; }
+
+vec2 directionToUv(vec3 d) {
+    return vec2(atan(d.z, d.x) / (2.0 * PI) + 0.5, acos(clamp(d.y, -1.0, 1.0)) / PI);
+}
+
+vec3 uvToDirection(vec2 uv) {
+    float phi = 2.0 * PI * (uv.x - 0.5), theta = PI * uv.y;
+    return vec3(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
+}
+
+ivec2 envTexel(vec2 uv) {
+    return clamp(ivec2(floor(uv * vec2(frame.envWidth, frame.envHeight))), ivec2(0),
+                 ivec2(frame.envWidth, frame.envHeight) - 1);
+}
+
+vec3 envTexelRadiance(ivec2 t) {
+    return texelFetch(textures[nonuniformEXT(frame.envMap)], t, 0).rgb * frame.envScale;
+}
+
+// Probability of texel t: its row's, times its column's within the row.
+float envTexelProbability(ivec2 t) {
+    uint w = frame.envWidth, h = frame.envHeight;
+    uint row = h + 1u + uint(t.y) * (w + 1u);
+    return (envCdf[t.y + 1] - envCdf[t.y]) * (envCdf[row + uint(t.x) + 1u] - envCdf[row + uint(t.x)]);
+}
+
+// The largest k in [0, n - 1] with envCdf[base + k] <= u.
+uint searchCdf(uint base, uint n, float u) {
+    uint lo = 0u, hi = n - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi + 1u) / 2u;
+        if (envCdf[base + mid] <= u) lo = mid; else hi = mid - 1u;
+    }
+    return lo;
+}
+
+vec3 environmentRadiance(vec3 d) {
+    return envMapped() ? envTexelRadiance(envTexel(directionToUv(d))) : frame.background;
+}
+
+float environmentPdf(vec3 d) {
+    if (!envMapped()) return 1.0 / (4.0 * PI);
+    float sinTheta = sqrt(max(0.0, 1.0 - d.y * d.y));
+    if (sinTheta <= 0.0) return 0.0;
+    return envTexelProbability(envTexel(directionToUv(d))) * float(frame.envWidth * frame.envHeight)
+         / (2.0 * PI * PI * sinTheta);
+}
+
+LightSample sampleEnvironmentMap(vec2 u) {
+    LightSample s;
+    s.valid = false;
+    s.dist = 1e30;
+    s.pdf = 0.0;
+    s.radiance = vec3(0.0);
+    s.wi = vec3(0.0, 1.0, 0.0);
+    uint w = frame.envWidth, h = frame.envHeight;
+    uint j = searchCdf(0u, h, u.x);
+    float pRow = envCdf[j + 1u] - envCdf[j];
+    uint row = h + 1u + j * (w + 1u);
+    uint i = searchCdf(row, w, u.y);
+    float pCol = envCdf[row + i + 1u] - envCdf[row + i];
+    if (pRow <= 0.0 || pCol <= 0.0) return s;
+    float fv = clamp((u.x - envCdf[j]) / pRow, 0.0, 1.0);
+    float fu = clamp((u.y - envCdf[row + i]) / pCol, 0.0, 1.0);
+    vec2 uv = vec2((float(i) + fu) / float(w), (float(j) + fv) / float(h));
+    float sinTheta = sin(PI * uv.y);
+    if (sinTheta <= 0.0) return s;
+    s.wi = uvToDirection(uv);
+    s.pdf = pRow * pCol * float(w * h) / (2.0 * PI * PI * sinTheta);
+    s.radiance = envTexelRadiance(ivec2(i, j));
+    s.valid = true;
+    return s;
+}
 
 // Height of a displacement map and its derivatives in (u, v), by central
 // differences one texel apart.
@@ -127,16 +212,17 @@ vec3 offsetOrigin(vec3 p, vec3 n, vec3 dir) {
     return p + (dot(dir, n) >= 0.0 ? n : -n) * (2e-4 * scale);
 }
 
-bool environmentLit() { return any(greaterThan(frame.background, vec3(0.0))); }
+bool environmentLit() { return frame.envMap != NO_TEXTURE || any(greaterThan(frame.background, vec3(0.0))); }
 
 // Light index `frame.lightCount` stands for the uniform environment (the
 // background radiance) when it is not black.
 LightSample sampleLightOrEnvironment(uint i, vec3 x, vec2 u) {
-    return i == frame.lightCount ? sampleEnvironment(frame.background, u) : sampleLight(lights[i], x, u);
+    if (i != frame.lightCount) return sampleLight(lights[i], x, u);
+    return envMapped() ? sampleEnvironmentMap(u) : sampleEnvironment(frame.background, u);
 }
 
 float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
-    return i == frame.lightCount ? 1.0 / (4.0 * PI) : lightPdf(lights[i], x, wi);
+    return i == frame.lightCount ? environmentPdf(wi) : lightPdf(lights[i], x, wi);
 }
 
 // The first area light that o + t d meets before tmax: its index (or
@@ -200,7 +286,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         uint which = firstLightHit(o, d, h.object == NO_HIT ? 1e30 : h.t, tl);
         if (which != frame.lightCount || h.object == NO_HIT) {
             // An emitter: a sphere or rect light, or the environment.
-            vec3 le = which != frame.lightCount ? v3(lights[which].color) : frame.background;
+            vec3 le = which != frame.lightCount ? v3(lights[which].color) : environmentRadiance(d);
             float w = 1.0;
             if (lastPdf > 0.0 && (which != frame.lightCount || environmentLit())) {
                 w = powerHeuristic(lastPdf, lightOrEnvironmentPdf(which, lastPoint, d) / float(choices));

@@ -29,6 +29,8 @@ pub const BINDING_RAYS: u32 = 5;
 pub const BINDING_HITS: u32 = 6;
 /// Descriptor binding of the texture array (render pass).
 pub const BINDING_TEXTURES: u32 = 10;
+/// Descriptor binding of the environment map's sampling tables (render pass).
+pub const BINDING_ENV_CDF: u32 = 11;
 /// Size of the texture array: a scene may use at most this many texture maps.
 pub const MAX_TEXTURES: u32 = 32;
 /// Texture index meaning "no map".

@@ -8,7 +8,8 @@
 //! light π L (r/d)² cos θ (a sphere above the horizon acts as a point source
 //! of intensity π r² L); rect light: numerical quadrature (f64, 200 x 200)
 //! of L cos θ cos θ_l / d² over its area; uniform environment: π L_env (the
-//! floor sees the whole upper hemisphere).
+//! floor sees the whole upper hemisphere); environment map: quadrature of
+//! L(d) cos θ over its texels.
 //!
 //! Bounds: the mean signed relative error over the lit pixels (the bias)
 //! within `BIAS_BOUND`; no pixel further than `OUTLIER_SIGMAS` times the RMS
@@ -69,13 +70,17 @@ fn rect_irradiance(x: DVec3, corner: DVec3, eu: DVec3, ev: DVec3, l: f64) -> f64
 }
 
 fn check(name: &str, light: Option<Light>, background: f64, irradiance: impl Fn(DVec3) -> f64) {
-    let visible_sphere = match light {
-        Some(Light::Sphere { centre, radius, .. }) => Some((centre, radius)),
-        _ => None,
-    };
     let mut scene = floor_scene();
     scene.lights.extend(light);
     scene.background = Vec3::splat(background as f32);
+    check_scene(name, scene, irradiance);
+}
+
+fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) {
+    let visible_sphere = match scene.lights.first() {
+        Some(Light::Sphere { centre, radius, .. }) => Some((*centre, *radius)),
+        _ => None,
+    };
     let ctx = common::context();
     let counters = ctx.counters();
     let out = quadray::render_scene(&ctx, &scene, &mut |_, _| {}).unwrap();
@@ -166,4 +171,38 @@ fn rect_light() {
 #[test]
 fn uniform_environment() {
     check("environment", None, 0.5, |_| std::f64::consts::PI * 0.5);
+}
+
+/// An environment map (a procedural sky with a small bright sun) lighting
+/// the floor through importance sampling of the map: E = ∫ L(d) cos⁺θ dω,
+/// computed by quadrature over the map's texels (piecewise constant).
+#[test]
+fn environment_map() {
+    use quadray::sampling::envmap::{procedural_sky, uv_to_direction, EnvironmentMap};
+    use quadray::scene::EnvironmentMapSettings;
+    let sky = procedural_sky(128, 64);
+    let map = EnvironmentMap::from_texture(&sky, 0.5);
+    let (w, h) = (map.width as usize, map.height as usize);
+    let mut e = 0.0;
+    let k = 8;
+    for j in 0..h {
+        for i in 0..w {
+            let l = map.texel_radiance(i, j).x;
+            for a in 0..k {
+                for b in 0..k {
+                    let u = (i as f64 + (a as f64 + 0.5) / k as f64) / w as f64;
+                    let v = (j as f64 + (b as f64 + 0.5) / k as f64) / h as f64;
+                    let d = uv_to_direction(u, v);
+                    // dω = 2π² sin θ du dv.
+                    let dw =
+                        2.0 * std::f64::consts::PI.powi(2) * (std::f64::consts::PI * v).sin() / (w * h * k * k) as f64;
+                    e += l * d.y.max(0.0) * dw;
+                }
+            }
+        }
+    }
+    let mut scene = floor_scene();
+    scene.textures.push(sky);
+    scene.environment = Some(EnvironmentMapSettings { texture: scene.textures.len() - 1, scale: 0.5 });
+    check_scene("environment map", scene, |_| e);
 }

@@ -268,6 +268,14 @@ pub struct GpuFrame {
     pub light_count: u32,
     /// Longest path in bounces.
     pub max_depth: u32,
+    /// Texture index of the environment map, or `NO_TEXTURE`.
+    pub env_map: u32,
+    /// Environment map width.
+    pub env_width: u32,
+    /// Environment map height.
+    pub env_height: u32,
+    /// Environment map radiance scale.
+    pub env_scale: f32,
 }
 
 /// `Aov` in render.comp.
@@ -341,7 +349,7 @@ const _: () = {
     assert!(std::mem::size_of::<GpuCell>() == 32);
     assert!(std::mem::size_of::<GpuMaterial>() == 84);
     assert!(std::mem::size_of::<GpuLight>() == 56);
-    assert!(std::mem::size_of::<GpuFrame>() == 80);
+    assert!(std::mem::size_of::<GpuFrame>() == 96);
     assert!(std::mem::size_of::<GpuAov>() == 28);
     assert!(std::mem::size_of::<GpuRay>() == 32);
     assert!(std::mem::size_of::<GpuHit>() == 32);

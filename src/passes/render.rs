@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::gpu::{GpuAov, GpuFrame, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use crate::scene::Scene;
-use crate::shader_interface::{INTERSECT_FULL, MAX_TEXTURES, RENDER_GROUP, SHADING_FULL};
+use crate::shader_interface::{INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
 use crate::vk::{
     full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation,
 };
@@ -77,6 +77,10 @@ pub fn render(
         seed: scene.image.seed,
         light_count: gpu.light_count,
         max_depth: scene.image.max_depth.max(1),
+        env_map: gpu.environment.map_or(NO_TEXTURE, |e| e.0),
+        env_width: gpu.environment.map_or(0, |e| e.1),
+        env_height: gpu.environment.map_or(0, |e| e.2),
+        env_scale: gpu.environment.map_or(0.0, |e| e.3),
     };
     let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
     let accum = Image::new(
@@ -103,7 +107,12 @@ pub fn render(
 
     let mut kinds = vec![BindingKind::AccelerationStructure];
     kinds.extend([BindingKind::StorageBuffer; 7]);
-    kinds.extend([BindingKind::StorageImage, BindingKind::StorageBuffer, BindingKind::SampledImages(MAX_TEXTURES)]);
+    kinds.extend([
+        BindingKind::StorageImage,
+        BindingKind::StorageBuffer,
+        BindingKind::SampledImages(MAX_TEXTURES),
+        BindingKind::StorageBuffer,
+    ]);
     let pipeline = ComputePipeline::new(
         device,
         &shaders::render(),
@@ -124,6 +133,7 @@ pub fn render(
         Binding::Image(&accum),
         Binding::Buffer(&aov),
         gpu.texture_binding(),
+        Binding::Buffer(&gpu.env_cdf),
     ]);
 
     let tiles: Vec<[u32; 4]> = (0..height)

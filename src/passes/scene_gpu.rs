@@ -8,6 +8,7 @@ use glam::{DAffine3, DVec3};
 
 use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
 use crate::geometry::{Aabb, CellParams};
+use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Scene, TextureImage};
 use crate::shader_interface::MAX_TEXTURES;
 use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
@@ -52,6 +53,11 @@ pub struct GpuScene {
     pub textures: Vec<Image>,
     /// The sampler for every texture.
     pub sampler: Sampler,
+    /// The environment map's sampling tables (`EnvironmentMap::cdf_buffer`;
+    /// a placeholder when there is no map).
+    pub env_cdf: Buffer,
+    /// The environment map: (texture index, width, height, scale).
+    pub environment: Option<(u32, u32, u32, f32)>,
     /// Sizes.
     pub stats: GeometryStats,
 }
@@ -160,6 +166,14 @@ impl GpuScene {
             scene.textures.iter().map(|t| upload_texture(device, cmds, t)).collect::<Result<Vec<_>, _>>()?;
         let white = TextureImage { source: "white".into(), width: 1, height: 1, levels: vec![vec![[1.0; 4]]] };
         textures.push(upload_texture(device, cmds, &white)?);
+        let (environment, env_cdf) = match scene.environment {
+            Some(e) => {
+                let t = &scene.textures[e.texture];
+                let map = EnvironmentMap::from_texture(t, e.scale);
+                (Some((e.texture as u32, t.width, t.height, e.scale)), map.cdf_buffer())
+            }
+            None => (None, vec![0.0f32]),
+        };
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
         let lights: Vec<GpuLight> = scene.lights.iter().map(GpuLight::from).collect();
 
@@ -182,6 +196,8 @@ impl GpuScene {
             lights: storage(device, "lights", bytemuck::cast_slice(&lights))?,
             textures,
             sampler: Sampler::linear_repeat(device)?,
+            env_cdf: storage(device, "environment tables", bytemuck::cast_slice(&env_cdf))?,
+            environment,
             tlas,
             _blases: blases,
             stats,

@@ -19,16 +19,19 @@
 //! microfacet distribution, Smith masking, visible-normal sampling),
 //! [`fresnel`], [`bsdf`] (diffuse, conductor, mirror, smooth dielectric),
 //! [`lights`] (sphere, rectangle, directional, point and environment lights,
-//! the power heuristic) and [`chi2`] (the chi-square test harness).
+//! the power heuristic), [`envmap`] (importance sampling of a lat-long
+//! environment map) and [`chi2`] (the chi-square test harness).
 
 pub mod bsdf;
 pub mod chi2;
+pub mod envmap;
 pub mod fresnel;
 pub mod ggx;
 pub mod lights;
 pub mod warp;
 
 pub use bsdf::{reflect, refract, Bsdf, BsdfSample, Conductor, Diffuse, FresnelModel, Mirror, SmoothDielectric};
+pub use envmap::{direction_to_uv, procedural_sky, uv_to_direction, EnvironmentMap};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use lights::{
     pdf_rect_light, pdf_sphere_light, pdf_uniform_environment, power_heuristic, sample_directional_light,

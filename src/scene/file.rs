@@ -1068,7 +1068,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
 
     let lights = raw.lights.iter().enumerate().map(|(i, l)| build_light(src, i, l)).collect::<Result<Vec<_>, _>>()?;
 
-    Ok(Scene { image, camera, background, materials, objects, lights, textures: textures.images })
+    Ok(Scene { image, camera, background, materials, objects, lights, environment: None, textures: textures.images })
 }
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {

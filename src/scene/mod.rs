@@ -246,6 +246,19 @@ pub struct Scene {
     pub objects: Vec<SceneObject>,
     /// Lights.
     pub lights: Vec<Light>,
-    /// Texture maps used by the materials.
+    /// Texture maps used by the materials (and the environment map).
     pub textures: Vec<TextureImage>,
+    /// An environment map replacing the uniform `background`, if any.
+    pub environment: Option<EnvironmentMapSettings>,
+}
+
+/// A lat-long environment map: the radiance arriving from infinity, what
+/// rays that hit nothing see, importance-sampled as a light
+/// (`sampling::envmap` documents the mapping and the sampling).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvironmentMapSettings {
+    /// Index of the map in [`Scene::textures`] (level 0 is used).
+    pub texture: usize,
+    /// Radiance scale applied to the map.
+    pub scale: f32,
 }

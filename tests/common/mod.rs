@@ -48,6 +48,7 @@ pub fn scene_with(objects: Vec<SceneObject>) -> Scene {
         objects,
         lights: vec![Light::Point { position: DVec3::new(3.0, 6.0, 4.0), intensity: Vec3::splat(40.0) }],
         textures: vec![],
+        environment: None,
     }
 }
 
