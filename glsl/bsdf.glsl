@@ -143,15 +143,60 @@ vec3 conductorFresnel(Material mat, float cosI) {
 
 float materialAlpha(Material mat) { return mat.roughness * mat.roughness; }
 
+// A dielectric is rough when its α reaches ALPHA_DELTA and its index is not
+// 1 (an index-matched interface is a delta transmission).
+bool isRoughDielectric(Material mat) {
+    return mat.kind == MATERIAL_DIELECTRIC && materialAlpha(mat) >= ALPHA_DELTA && mat.ior != 1.0;
+}
+
 // True when the material scatters only into isolated directions (no NEE).
 bool isDelta(Material mat) {
-    if (mat.kind == MATERIAL_MIRROR || mat.kind == MATERIAL_DIELECTRIC) return true;
+    if (mat.kind == MATERIAL_MIRROR) return true;
+    if (mat.kind == MATERIAL_DIELECTRIC) return !isRoughDielectric(mat);
     if (mat.kind == MATERIAL_CONDUCTOR) return materialAlpha(mat) < ALPHA_DELTA;
     return false;
 }
 
+// ---- Rough dielectric --------------------------------------------------------
+// Walter, Marschner, Li, Torrance, "Microfacet Models for Refraction through
+// Rough Surfaces", EGSR 2007, with visible-normal sampling. Computed in the
+// "up" frame: directions mirrored through the tangent plane when wo.z < 0,
+// eta = n_t / n_i (the far side's index over wo's side's). The f64 twin,
+// whose documentation states every formula, is sampling::RoughDielectric.
+
+// f (radiance convention: transmission scaled by 1 / eta²) and pdf of the
+// pair (wo, wi); x: f, y: pdf.
+vec2 roughDielectricEvalPdf(Material mat, vec3 wo, vec3 wi) {
+    if (wo.z == 0.0 || wi.z == 0.0) return vec2(0.0);
+    float s = wo.z > 0.0 ? 1.0 : -1.0;
+    vec3 o = vec3(wo.xy, abs(wo.z));
+    vec3 i = vec3(wi.xy, s * wi.z);
+    float eta = s > 0.0 ? mat.ior : 1.0 / mat.ior;
+    float a = materialAlpha(mat);
+    if (i.z > 0.0) {
+        vec3 h = normalize(o + i);
+        float c = dot(o, h);
+        if (h.z <= 0.0 || c <= 0.0) return vec2(0.0);
+        float f = fresnelDielectric(c, eta);
+        return vec2(f * ggxD(h, a) * ggxG2(o, i, a) / (4.0 * o.z * i.z), f * ggxVisiblePdf(o, h, a) / (4.0 * c));
+    }
+    vec3 hv = o + eta * i;
+    float hl = length(hv);
+    if (hl == 0.0) return vec2(0.0);
+    vec3 h = hv / hl;
+    if (h.z < 0.0) h = -h;
+    float c = dot(o, h), ci = dot(i, h);
+    if (h.z <= 0.0 || c <= 0.0 || ci >= 0.0) return vec2(0.0);
+    float f = fresnelDielectric(c, eta);
+    float den = c + eta * ci;
+    float value = c * abs(ci) * (1.0 - f) * ggxG2(o, i, a) * ggxD(h, a) / (o.z * abs(i.z) * den * den);
+    float pdf = (1.0 - f) * ggxVisiblePdf(o, h, a) * eta * eta * abs(ci) / (den * den);
+    return vec2(value, pdf);
+}
+
 // f(wo, wi) (without the cosine) for non-delta lobes.
 vec3 bsdfEval(Material mat, vec3 wo, vec3 wi) {
+    if (isRoughDielectric(mat)) return vec3(roughDielectricEvalPdf(mat, wo, wi).x);
     if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
     if (mat.kind == MATERIAL_DIFFUSE) return v3(mat.albedo) / PI;
     if (mat.kind == MATERIAL_CONDUCTOR) {
@@ -164,6 +209,7 @@ vec3 bsdfEval(Material mat, vec3 wo, vec3 wi) {
 
 // Solid-angle density of bsdfSample choosing wi (non-delta lobes).
 float bsdfPdf(Material mat, vec3 wo, vec3 wi) {
+    if (isRoughDielectric(mat)) return roughDielectricEvalPdf(mat, wo, wi).y;
     if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
     if (mat.kind == MATERIAL_DIFFUSE) return wi.z / PI;
     if (mat.kind == MATERIAL_CONDUCTOR) {
@@ -186,8 +232,38 @@ BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
     s.pdf = 0.0;
     s.weight = vec3(0.0);
     s.wi = vec3(0.0, 0.0, 1.0);
+    if (isRoughDielectric(mat)) {
+        if (wo.z == 0.0) return s;
+        float sgn = wo.z > 0.0 ? 1.0 : -1.0;
+        vec3 o = vec3(wo.xy, abs(wo.z));
+        float eta = sgn > 0.0 ? mat.ior : 1.0 / mat.ior;
+        float a = materialAlpha(mat);
+        vec3 m = ggxSampleVisibleNormal(o, a, u.xy);
+        float c = dot(o, m);
+        if (c <= 0.0) return s;
+        float f = fresnelDielectric(c, eta);
+        vec3 i;
+        if (u.z < f) {
+            i = 2.0 * c * m - o;
+            if (i.z <= 0.0) return s;
+            s.pdf = f * ggxVisiblePdf(o, m, a) / (4.0 * c);
+            s.weight = vec3(ggxG2(o, i, a) / ggxG1(o, a));
+        } else {
+            float sin2T = (1.0 - c * c) / (eta * eta);
+            if (sin2T >= 1.0) return s;
+            float cosT = sqrt(1.0 - sin2T);
+            i = -o / eta + (c / eta - cosT) * m;
+            if (i.z >= 0.0) return s;
+            float den = c - eta * cosT;
+            s.pdf = (1.0 - f) * ggxVisiblePdf(o, m, a) * eta * eta * cosT / (den * den);
+            s.weight = vec3(ggxG2(o, i, a) / (ggxG1(o, a) * eta * eta));
+        }
+        s.wi = vec3(i.xy, sgn * i.z);
+        s.valid = s.pdf > 0.0 && !isinf(s.pdf) && !isnan(s.pdf);
+        return s;
+    }
     if (mat.kind == MATERIAL_DIELECTRIC) {
-        // Smooth dielectric (rough ones are rendered smooth for now).
+        // Smooth dielectric.
         if (wo.z == 0.0) return s;
         float f = fresnelDielectric(wo.z, mat.ior);
         if (u.z < f) {

@@ -225,12 +225,13 @@ float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
     return i == frame.lightCount ? environmentPdf(wi) : lightPdf(lights[i], x, wi);
 }
 
-// The first area light that o + t d meets before tmax: its index (or
-// frame.lightCount when none) and distance.
-uint firstLightHit(vec3 o, vec3 d, float tmax, out float tHit) {
+// The first area light other than `except` that o + t d meets before tmax:
+// its index (or frame.lightCount when none) and distance.
+uint firstLightHit(vec3 o, vec3 d, float tmax, uint except, out float tHit) {
     uint which = frame.lightCount;
     tHit = tmax;
     for (uint i = 0; i < frame.lightCount; ++i) {
+        if (i == except) continue;
         float t = lightHit(lights[i], o, d);
         if (t < tHit) {
             tHit = t;
@@ -251,20 +252,22 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, in
     if (choices == 0u) return vec3(0.0);
     uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
     float select = 1.0 / float(choices);
-    // Sample from the shadow ray's origin (offset off the surface on the side
-    // of the shading normal, the only side a non-delta material reflects to),
-    // so that the light's distance is measured from where the ray starts.
-    vec3 origin = offsetOrigin(p, ng, frameW[2]);
-    LightSample ls = sampleLightOrEnvironment(i, origin, rand2(rng));
+    LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     vec3 wiLocal = transpose(frameW) * ls.wi;
     vec3 f = bsdfEval(mat, wo, wiLocal);
     if (all(equal(f, vec3(0.0)))) return vec3(0.0);
-    if (occluded(origin, ls.wi, 0.0, ls.dist)) return vec3(0.0);
-    // Area lights may hide each other: a sphere or rect light in front blocks this one.
-    if (i < frame.lightCount) {
+    // The shadow ray starts off the surface on the side of the light (either
+    // side for a rough dielectric); the light's distance is shortened by the
+    // part of the offset along the ray, so that the ray ends at the light.
+    vec3 origin = offsetOrigin(p, ng, ls.wi);
+    float dist = ls.dist - dot(origin - p, ls.wi);
+    if (occluded(origin, ls.wi, 0.0, dist)) return vec3(0.0);
+    // Area lights may hide each other: another sphere or rect light in front
+    // blocks this one (lights are not in the acceleration structure).
+    {
         float tl;
-        uint first = firstLightHit(origin, ls.wi, ls.dist * (1.0 - 1e-4), tl);
+        uint first = firstLightHit(origin, ls.wi, dist, i, tl);
         if (first != frame.lightCount) return vec3(0.0);
     }
     vec3 contribution = f * abs(wiLocal.z) * ls.radiance / select;
@@ -283,7 +286,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
     for (uint bounce = 0u; bounce < frame.maxDepth; ++bounce) {
         SceneHit h = traceScene(o, d, 0.0, 1e30);
         float tl;
-        uint which = firstLightHit(o, d, h.object == NO_HIT ? 1e30 : h.t, tl);
+        uint which = firstLightHit(o, d, h.object == NO_HIT ? 1e30 : h.t, frame.lightCount, tl);
         if (which != frame.lightCount || h.object == NO_HIT) {
             // An emitter: a sphere or rect light, or the environment.
             vec3 le = which != frame.lightCount ? v3(lights[which].color) : environmentRadiance(d);

@@ -123,14 +123,34 @@ fn chi2_procedural_sky() {
     check("sky 64x32, whole sphere", &r);
 }
 
+/// The sun, finely binned: a 9.5° cap around it (the 2.5° disk and the four
+/// texels it covers, 82 % of the probability, whose farthest corner is 8.7°
+/// away) in 20 × 40 cells, the rest of the sphere in one cell.
+///
+/// The map is the sky with its top and bottom rows made black: the rest cell
+/// holds both poles, near which the density of a lit pole row is unbounded
+/// (∝ 1/sin θ), and the harness's quadrature of one cell that large around
+/// them is unreliable (∫pdf dω comes out 1.35 with the full sky). The pole
+/// rows are tested by the whole-sphere test. 5·10⁵ samples: the quadrature
+/// of the rest cell to 1e-3 / 10⁶ takes 20 times as long.
 #[test]
 fn chi2_procedural_sky_sun_cap() {
-    let map = sky();
+    let texture = procedural_sky(64, 32);
+    let mut texels = texture.levels[0].clone();
+    let n = texels.len();
+    texels[..64].fill([0.0; 4]);
+    texels[n - 64..].fill([0.0; 4]);
+    let map = EnvironmentMap::from_rgba(64, 32, &texels, 1.0);
     let sun = sky_sun_direction();
-    // 12° around the sun: the sun disk (2.5°) and its texels, finely binned.
-    let config = Chi2Config { axis: sun, cap_cos: 12f64.to_radians().cos(), seed: 102, ..Chi2Config::default() };
+    let config = Chi2Config {
+        samples: 500_000,
+        axis: sun,
+        cap_cos: 9.5f64.to_radians().cos(),
+        seed: 102,
+        ..Chi2Config::default()
+    };
     let r = chi2_test(&config, sampler(&map), |d| map.pdf(d));
-    check("sky 64x32, 12° cap on the sun", &r);
+    check("sky 64x32 (pole rows black), 9.5° sun cap", &r);
 }
 
 #[test]
@@ -235,7 +255,8 @@ fn sample_pdf_and_radiance_agree_with_lookups() {
         let mut rng = Pcg32::new(77, 1);
         let (mut checked, mut border, mut invalid, mut worst) = (0usize, 0usize, 0usize, 0.0f64);
         let mut us: Vec<(f64, f64)> = (0..200_000).map(|_| (rng.next_f64(), rng.next_f64())).collect();
-        // The ends of the unit interval too.
+        // The ends of the unit interval too (25 pairs: u = 0 lands on a texel
+        // border, u1 = 0 at the pole when the top row is lit).
         let ends = [0.0, 1e-12, 0.5, 1.0 - 1e-12, 1.0 - f64::EPSILON / 2.0];
         us.extend(ends.iter().flat_map(|&a| ends.iter().map(move |&b| (a, b))));
         for (u1, u2) in us {
@@ -260,7 +281,7 @@ fn sample_pdf_and_radiance_agree_with_lookups() {
             "{name:<20} {checked} samples: worst relative pdf difference {worst:.2e}; {border} at texel borders, \
              {invalid} invalid"
         );
-        assert!(border <= 30 && invalid <= 5, "{name}: {border} border samples, {invalid} invalid");
+        assert!(border <= 25 + 5 && invalid <= 5, "{name}: {border} border samples, {invalid} invalid");
     }
 }
 

@@ -987,3 +987,181 @@ fn textured_example_scene() {
         assert_eq!(t.levels.last().unwrap().len(), 1);
     }
 }
+
+/// A scene with an `[environment]` table on line 4 and `line` on line 5.
+fn environment_scene(line: &str) -> String {
+    format!("{CAMERA}[environment]\n{line}\n")
+}
+
+#[test]
+fn missing_environment_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, environment_scene("map = \"skies/missing.exr\"")).unwrap();
+    let m = load_scene(&scene).unwrap_err().to_string();
+    let texture = dir.path().join("skies/missing.exr");
+    let expected = format!(
+        "{}:5:7: environment.map: cannot load the environment map: {}: no such file",
+        scene.display(),
+        texture.display()
+    );
+    assert_eq!(m.lines().next().unwrap(), expected, "{m}");
+    assert!(m.contains("5 | map = \"skies/missing.exr\"\n  |       ^^^^^^^^^^^^^^^^^^^"), "{m}");
+
+    // The table form points at its `file`.
+    let m = check(
+        "missing_env_table.toml",
+        &environment_scene("map = { file = \"sky.png\" }\nscale = 2"),
+        5,
+        &["environment.map.file: cannot load the environment map:", "sky.png: no such file"],
+    );
+    assert!(m.contains(":5:16:"), "{m}");
+
+    // Not an image.
+    std::fs::write(dir.path().join("sky.exr"), b"not an EXR file").unwrap();
+    std::fs::write(&scene, environment_scene("map = \"sky.exr\"")).unwrap();
+    let m = load_scene(&scene).unwrap_err().to_string();
+    assert!(m.starts_with(&format!("{}:5:7: environment.map: cannot load the environment map: ", scene.display())));
+    assert!(m.contains("sky.exr: not a valid EXR image"), "{m}");
+}
+
+#[test]
+fn environment_files_load_relative_to_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("skies")).unwrap();
+    image::RgbImage::from_pixel(6, 3, image::Rgb([255, 128, 0])).save(dir.path().join("skies/sky.png")).unwrap();
+    let scene = dir.path().join("s.toml");
+    std::fs::write(&scene, environment_scene("map = \"skies/sky.png\"\nscale = 3")).unwrap();
+    let s = load_scene(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let env = s.environment.unwrap();
+    assert_eq!((env.texture, env.scale), (0, 3.0));
+    let t = &s.textures[0];
+    // Resampled to powers of two; sRGB-decoded like a colour map.
+    assert_eq!((t.width, t.height), (8, 4));
+    let texel = t.levels[0][0];
+    assert!((texel[0] - 1.0).abs() < 1e-5 && (texel[1] - 0.215_860_5).abs() < 1e-5 && texel[2] == 0.0, "{texel:?}");
+}
+
+#[test]
+fn bad_environment_values() {
+    check(
+        "sky_width.toml",
+        &environment_scene("map = { sky = { width = 500, height = 250 } }"),
+        5,
+        &["environment.map.sky.width", "must be a power of two from 2 to 4096", "(got 500)", ":5:25:"],
+    );
+    check(
+        "sky_height.toml",
+        &environment_scene("map = { sky = { width = 512, height = 4096 } }"),
+        5,
+        &["environment.map.sky.height", "must be a power of two from 1 to 2048", "(got 4096)"],
+    );
+    check(
+        "sky_too_wide.toml",
+        &environment_scene("map = { sky = { width = 8192, height = 1024 } }"),
+        5,
+        &["environment.map.sky.width", "(got 8192)"],
+    );
+    check(
+        "sky_no_height.toml",
+        &environment_scene("map = { sky = { width = 512 } }"),
+        5,
+        &["environment.map.sky.height", "the required key `height` is missing"],
+    );
+    check(
+        "negative_env_scale.toml",
+        &environment_scene("map = { sky = { width = 8, height = 4 } }\nscale = -0.5"),
+        6,
+        &["environment.scale", "must not be negative (got -0.5)", ":6:9:"],
+    );
+    check(
+        "nan_env_scale.toml",
+        &environment_scene("map = { sky = { width = 8, height = 4 } }\nscale = nan"),
+        6,
+        &["environment.scale", "must be a finite number"],
+    );
+    check("no_env_map.toml", &environment_scene("scale = 1"), 4, &["environment.map", "the required key `map`"]);
+    check(
+        "env_file_and_sky.toml",
+        &environment_scene("map = { sky = { width = 8, height = 4 }, file = \"a.exr\" }"),
+        5,
+        &["environment.map.file", "needs exactly one of `file` and `sky`; found both"],
+    );
+    check(
+        "env_neither.toml",
+        &environment_scene("map = {}"),
+        5,
+        &["environment.map", "needs exactly one of `file` and `sky`; found neither"],
+    );
+    check("env_empty_path.toml", &environment_scene("map = \"\""), 5, &["environment.map", "must not be empty"]);
+}
+
+#[test]
+fn unknown_environment_keys() {
+    check(
+        "env_typo.toml",
+        &environment_scene("map = { sky = { width = 8, height = 4 } }\nscael = 2"),
+        6,
+        &["environment.scael", "unknown field `scael`", "expected `map` or `scale`"],
+    );
+    check(
+        "env_map_typo.toml",
+        &environment_scene("map = { skye = { width = 8, height = 4 } }"),
+        5,
+        &["environment.map.skye", "unknown field `skye`", "expected `file` or `sky`"],
+    );
+    check(
+        "sky_typo.toml",
+        &environment_scene("map = { sky = { width = 8, heigth = 4 } }"),
+        5,
+        &["environment.map.sky.heigth", "unknown field `heigth`"],
+    );
+    // A checker is a material map, not an environment.
+    check(
+        "env_checker.toml",
+        &environment_scene("map = { checker = { size = 8, cells = 2, colors = [0, 1] } }"),
+        5,
+        &["environment.map.checker", "unknown field `checker`"],
+    );
+}
+
+#[test]
+fn background_and_environment_together() {
+    let sky = "map = { sky = { width = 8, height = 4 } }";
+    // The [environment] table comes second: the error points at its header.
+    let m = check(
+        "both.toml",
+        &format!("background = [0.1, 0.1, 0.1]\n{CAMERA}[environment]\n{sky}\n"),
+        5,
+        &["environment: give either background or [environment], not both", "(background is at line 1)"],
+    );
+    assert!(m.contains("both.toml:5:1:") && m.contains("\n5 | [environment]\n  | ^"), "{m}");
+    // Inline before the background: the error points at the background.
+    let m = check(
+        "both_inline.toml",
+        &format!("environment = {{ {sky} }}\nbackground = [0, 0, 0]\n{CAMERA}"),
+        2,
+        &["background: give either background or [environment], not both", "([environment] is at line 1)"],
+    );
+    assert!(m.contains("both_inline.toml:2:14:"), "{m}");
+}
+
+#[test]
+fn sky_example_scene() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sky.toml");
+    let s = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((s.image.width, s.image.height, s.image.spp, s.image.max_depth), (640, 480, 32, 6));
+    // Lit only by the sky.
+    assert!(s.lights.is_empty());
+    assert!(s.materials.iter().all(|m| m.emission == glam::Vec3::ZERO));
+    assert_eq!(s.background, glam::Vec3::ZERO);
+    let env = s.environment.expect("an environment map");
+    assert_eq!(env.scale, 1.0);
+    let sky = &s.textures[env.texture];
+    assert_eq!(*sky, quadray::sampling::envmap::procedural_sky(512, 256));
+    // A glossy metal sphere and a diffuse floor.
+    let material = |name: &str| &s.materials[s.objects.iter().find(|o| o.name == name).unwrap().material];
+    let MaterialKind::Conductor { roughness, .. } = material("metal sphere").kind else { panic!("not a metal") };
+    assert!(roughness > 0.0 && roughness < 0.2, "glossy: {roughness}");
+    assert_eq!(material("floor").kind, MaterialKind::Diffuse);
+}

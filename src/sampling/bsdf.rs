@@ -244,8 +244,9 @@ impl Mirror {
 /// refraction, both delta lobes. The inside (wo.z < 0) has index `ior`
 /// relative to the outside.
 ///
-/// For now every dielectric material is rendered with this smooth model, its
-/// roughness ignored: rough (GGX) dielectrics are not implemented yet.
+/// [`Bsdf::from_material`] uses it for dielectrics with α < [`DELTA_ALPHA`]
+/// (and for ior = 1, see [`RoughDielectric`]); rougher ones are
+/// [`RoughDielectric`].
 ///
 /// What is conserved: the sample chooses reflection with probability F and
 /// refraction with probability 1 − F, so E\[weight\] = F + (1 − F)/eta_rel²;
@@ -294,6 +295,170 @@ impl SmoothDielectric {
     }
 }
 
+/// A rough dielectric interface: GGX microfacet reflection and refraction
+/// after B. Walter, S. R. Marschner, H. Li and K. E. Torrance, "Microfacet
+/// Models for Refraction through Rough Surfaces", EGSR 2007, with the
+/// visible-normal sampling of [`ggx::sample_vndf`] (Heitz 2018). The inside
+/// (wo.z < 0) has index `ior` relative to the outside; `wo` may be on either
+/// side. Requires ior ≠ 1 (an index-matched interface is invisible: a delta
+/// transmission, which [`Bsdf::from_material`] gives to [`SmoothDielectric`]).
+///
+/// **The up frame.** With s = sign(wo.z) (wo.z = 0: `sample` returns `None`,
+/// `eval` and `pdf` 0), everything is computed with directions mirrored
+/// through the tangent plane when s < 0: o = (wo.x, wo.y, |wo.z|),
+/// i = (wi.x, wi.y, s·wi.z), and with eta = (s > 0 ? ior : 1/ior) = n_t/n_i,
+/// the index of the far side over that of wo's side. A sampled i is mirrored
+/// back at the end: wi = (i.x, i.y, s·i.z). D = [`ggx::d`],
+/// G1 = [`ggx::g1`], G2(o, i) = [`ggx::g2`] = 1/(1 + Λ(o) + Λ(i)) with Λ on
+/// |z| (the height-correlated form, used for both lobes),
+/// D_o(m) = [`ggx::pdf_vndf`](α, o, m) = G1(o) max(0, o·m) D(m)/o.z, and
+/// F(c) = [`fresnel_dielectric`](c, eta) with c > 0.
+///
+/// **Sampling** (u1, u2, u3): m = [`ggx::sample_vndf`](α, o, u1, u2),
+/// c = o·m; `None` if c ≤ 0. F = F(c).
+/// - u3 < F, reflection: i = 2c m − o; `None` if i.z ≤ 0.
+///   pdf = F D_o(m) / (4c); weight = G2(o, i)/G1(o).
+/// - otherwise refraction: sin²θt = (1 − c²)/eta² (`None` if ≥ 1, which
+///   cannot happen as F = 1 there), cos_t = √(1 − sin²θt),
+///   i = −o/eta + (c/eta − cos_t) m (so i·m = −cos_t); `None` if i.z ≥ 0.
+///   pdf = (1 − F) D_o(m) eta² cos_t / (c − eta cos_t)² (Walter eq. 17, the
+///   Jacobian dω_m/dω_i = eta² |i·m| / (o·m + eta i·m)²);
+///   weight = G2(o, i) / (G1(o) eta²).
+/// - `None` too unless pdf > 0 and finite.
+///
+/// **eval and pdf** for any pair, in the up frame (both 0 when o.z = 0 or
+/// i.z = 0):
+/// - i.z > 0, reflection: h = normalize(o + i), c = o·h (0 unless h.z > 0 and
+///   c > 0), F = F(c); f = F D(h) G2(o, i) / (4 o.z i.z) (Walter eq. 20),
+///   pdf = F D_o(h) / (4c).
+/// - i.z < 0, refraction: h = normalize(o + eta i) (Walter's generalised half
+///   vector; 0 if o + eta i = 0), negated if h.z < 0; c = o·h, ci = i·h; 0
+///   unless h.z > 0, c > 0 and ci < 0. F = F(c), den = c + eta ci;
+///   f = c |ci| (1 − F) G2(o, i) D(h) / (o.z |i.z| den²),
+///   pdf = (1 − F) D_o(h) eta² |ci| / den².
+///
+/// f is returned as the same value in all three channels. The transmission
+/// f is Walter's eq. 21 with η_i = 1, η_o = eta, f_W = c |ci| eta² (1 − F)
+/// G2 D / (o.z |i.z| den²), times 1/eta²: the radiance carried along camera
+/// paths (the convention of [`SmoothDielectric`], to which the lobes tend as
+/// α → 0: reflection weight G2/G1 → 1, refraction weight G2/(G1 eta²) →
+/// 1/eta²). The flux (power) albedo, undoing that scaling, is
+/// ∫ (f_r + eta² f_t) |cos θi| dωi = ∫ D_o(m) G2/G1 (F \[i_r.z > 0\] +
+/// (1 − F) \[i_t.z < 0\]) dω_m ≤ 1, with i_r, i_t the reflected and
+/// refracted directions of m. Reciprocity: f(wo, wi) = f(wi, wo) for
+/// reflection; f(wo, wi)/n_wo² = f(wi, wo)/n_wi² for refraction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughDielectric {
+    /// GGX α (roughness²), ≥ [`DELTA_ALPHA`] in the renderer.
+    pub alpha: f64,
+    /// Index of refraction of the inside relative to the outside (≠ 1).
+    pub ior: f64,
+}
+
+impl RoughDielectric {
+    /// A rough dielectric of perceptual `roughness` (α = roughness²).
+    pub fn new(roughness: f64, ior: f64) -> Self {
+        Self { alpha: alpha_from_roughness(roughness), ior }
+    }
+
+    /// s = sign(wo.z), o = wo mirrored to +z, eta = n_t/n_i; `None` for wo.z = 0.
+    fn up_frame(&self, wo: DVec3) -> Option<(f64, DVec3, f64)> {
+        if wo.z == 0.0 || wo.z.is_nan() {
+            return None;
+        }
+        let s = if wo.z > 0.0 { 1.0 } else { -1.0 };
+        let eta = if s > 0.0 { self.ior } else { 1.0 / self.ior };
+        Some((s, DVec3::new(wo.x, wo.y, wo.z.abs()), eta))
+    }
+
+    /// (f, pdf) of the pair (see the type's documentation).
+    fn eval_pdf(&self, wo: DVec3, wi: DVec3) -> (f64, f64) {
+        let Some((s, o, eta)) = self.up_frame(wo) else { return (0.0, 0.0) };
+        let i = DVec3::new(wi.x, wi.y, s * wi.z);
+        let a = self.alpha;
+        if i.z > 0.0 {
+            let h = (o + i).normalize();
+            let c = o.dot(h);
+            if h.z <= 0.0 || c <= 0.0 {
+                return (0.0, 0.0);
+            }
+            let f = fresnel_dielectric(c, eta);
+            let value = f * ggx::d(a, h) * ggx::g2(a, o, i) / (4.0 * o.z * i.z);
+            (value, f * ggx::pdf_vndf(a, o, h) / (4.0 * c))
+        } else if i.z < 0.0 {
+            let v = o + eta * i;
+            let len2 = v.length_squared();
+            if len2 <= 0.0 {
+                return (0.0, 0.0);
+            }
+            let mut h = v / len2.sqrt();
+            if h.z < 0.0 {
+                h = -h;
+            }
+            let (c, ci) = (o.dot(h), i.dot(h));
+            if h.z <= 0.0 || c <= 0.0 || ci >= 0.0 {
+                return (0.0, 0.0);
+            }
+            let t = 1.0 - fresnel_dielectric(c, eta);
+            let den = c + eta * ci;
+            let den2 = den * den;
+            let value = c * -ci * t * ggx::g2(a, o, i) * ggx::d(a, h) / (o.z * -i.z * den2);
+            (value, t * ggx::pdf_vndf(a, o, h) * eta * eta * -ci / den2)
+        } else {
+            (0.0, 0.0)
+        }
+    }
+
+    /// f(wo, wi) (radiance convention; see the type's documentation).
+    pub fn eval(&self, wo: DVec3, wi: DVec3) -> DVec3 {
+        DVec3::splat(self.eval_pdf(wo, wi).0)
+    }
+
+    /// The solid-angle density with which [`RoughDielectric::sample`]
+    /// produces `wi`.
+    pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+        self.eval_pdf(wo, wi).1
+    }
+
+    /// Samples a visible microfacet normal (u1, u2), then reflection with
+    /// probability F (u3 < F) or refraction (see the type's documentation).
+    pub fn sample(&self, wo: DVec3, u1: f64, u2: f64, u3: f64) -> Option<BsdfSample> {
+        let (s, o, eta) = self.up_frame(wo)?;
+        let a = self.alpha;
+        let m = ggx::sample_vndf(a, o, u1, u2);
+        let c = o.dot(m);
+        if c <= 0.0 {
+            return None;
+        }
+        let f = fresnel_dielectric(c, eta);
+        let d_o = ggx::pdf_vndf(a, o, m);
+        let (i, weight, pdf) = if u3 < f {
+            let i = 2.0 * c * m - o;
+            if i.z <= 0.0 {
+                return None;
+            }
+            (i, ggx::g2(a, o, i) / ggx::g1(a, o), f * d_o / (4.0 * c))
+        } else {
+            let sin2_t = (1.0 - c * c) / (eta * eta);
+            if sin2_t >= 1.0 {
+                return None;
+            }
+            let cos_t = (1.0 - sin2_t).sqrt();
+            let i = -o / eta + (c / eta - cos_t) * m;
+            if i.z >= 0.0 {
+                return None;
+            }
+            let den = c - eta * cos_t;
+            let pdf = (1.0 - f) * d_o * eta * eta * cos_t / (den * den);
+            (i, ggx::g2(a, o, i) / (ggx::g1(a, o) * eta * eta), pdf)
+        };
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        Some(BsdfSample { wi: DVec3::new(i.x, i.y, s * i.z), weight: DVec3::splat(weight), pdf: Some(pdf) })
+    }
+}
+
 /// Any of the BSDFs, as the renderer selects it from a scene material.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bsdf {
@@ -303,12 +468,16 @@ pub enum Bsdf {
     Conductor(Conductor),
     /// [`Mirror`].
     Mirror(Mirror),
-    /// [`SmoothDielectric`] (every dielectric, whatever its roughness).
+    /// [`SmoothDielectric`]: dielectrics with α < [`DELTA_ALPHA`] (or ior = 1).
     Dielectric(SmoothDielectric),
+    /// [`RoughDielectric`]: dielectrics with α ≥ [`DELTA_ALPHA`] (and ior ≠ 1).
+    RoughDielectric(RoughDielectric),
 }
 
 impl Bsdf {
-    /// The BSDF of a scene material (f32 parameters widened to f64).
+    /// The BSDF of a scene material (f32 parameters widened to f64). A
+    /// dielectric of perceptual roughness r becomes a [`RoughDielectric`] when
+    /// α = r² ≥ [`DELTA_ALPHA`] and ior ≠ 1, else a [`SmoothDielectric`].
     pub fn from_material(material: &Material) -> Self {
         let albedo = material.albedo.as_dvec3();
         match &material.kind {
@@ -322,7 +491,16 @@ impl Bsdf {
                 };
                 Self::Conductor(Conductor::new(f64::from(*roughness), fresnel))
             }
-            MaterialKind::Dielectric { ior, .. } => Self::Dielectric(SmoothDielectric { ior: f64::from(*ior) }),
+            MaterialKind::Dielectric { roughness, ior } => {
+                let (alpha, ior) = (alpha_from_roughness(f64::from(*roughness)), f64::from(*ior));
+                // ior = 1: an index-matched interface, invisible whatever its
+                // roughness (RoughDielectric is degenerate there).
+                if alpha < DELTA_ALPHA || ior == 1.0 {
+                    Self::Dielectric(SmoothDielectric { ior })
+                } else {
+                    Self::RoughDielectric(RoughDielectric { alpha, ior })
+                }
+            }
             MaterialKind::Mirror => Self::Mirror(Mirror { albedo }),
         }
     }
@@ -334,6 +512,7 @@ impl Bsdf {
             Self::Conductor(b) => b.eval(wo, wi),
             Self::Mirror(b) => b.eval(wo, wi),
             Self::Dielectric(b) => b.eval(wo, wi),
+            Self::RoughDielectric(b) => b.eval(wo, wi),
         }
     }
 
@@ -344,6 +523,7 @@ impl Bsdf {
             Self::Conductor(b) => b.pdf(wo, wi),
             Self::Mirror(b) => b.pdf(wo, wi),
             Self::Dielectric(b) => b.pdf(wo, wi),
+            Self::RoughDielectric(b) => b.pdf(wo, wi),
         }
     }
 
@@ -354,13 +534,14 @@ impl Bsdf {
             Self::Conductor(b) => b.sample(wo, u1, u2, u3),
             Self::Mirror(b) => b.sample(wo, u1, u2, u3),
             Self::Dielectric(b) => b.sample(wo, u1, u2, u3),
+            Self::RoughDielectric(b) => b.sample(wo, u1, u2, u3),
         }
     }
 
     /// Whether every lobe is a delta lobe (`eval` and `pdf` are then 0).
     pub fn is_delta(&self) -> bool {
         match self {
-            Self::Diffuse(_) => false,
+            Self::Diffuse(_) | Self::RoughDielectric(_) => false,
             Self::Conductor(b) => b.is_delta(),
             Self::Mirror(_) | Self::Dielectric(_) => true,
         }
@@ -396,5 +577,31 @@ mod tests {
         assert!((pdf - c.pdf(wo, s.wi)).abs() < 1e-12 * pdf);
         let want = c.eval(wo, s.wi) * s.wi.z / pdf;
         assert!((s.weight - want).abs().max_element() < 1e-12);
+    }
+
+    #[test]
+    fn rough_dielectric_samples_agree_with_eval_and_pdf_from_both_sides() {
+        let b = RoughDielectric::new(0.5, 1.5);
+        let (mut reflected, mut refracted) = (0, 0);
+        for wo in [DVec3::new(0.3, -0.4, 0.866), DVec3::new(0.2, 0.1, -0.9), DVec3::new(-0.6, 0.2, -0.5)] {
+            let wo = wo.normalize();
+            for (u1, u2) in [(0.1, 0.2), (0.5, 0.9), (0.8, 0.4)] {
+                for u3 in [0.0, 0.999] {
+                    let Some(s) = b.sample(wo, u1, u2, u3) else { continue };
+                    let pdf = s.pdf.unwrap();
+                    assert!((b.pdf(wo, s.wi) - pdf).abs() < 1e-10 * pdf);
+                    let want = b.eval(wo, s.wi) * s.wi.z.abs() / pdf;
+                    assert!((s.weight - want).abs().max_element() < 1e-10 * want.x);
+                    if s.wi.z * wo.z > 0.0 {
+                        reflected += 1;
+                    } else {
+                        refracted += 1;
+                    }
+                }
+            }
+        }
+        assert!(reflected > 0 && refracted > 0);
+        assert!(b.sample(DVec3::X, 0.5, 0.5, 0.5).is_none());
+        assert_eq!(b.eval(DVec3::X, DVec3::Z), DVec3::ZERO);
     }
 }

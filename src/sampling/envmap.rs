@@ -84,8 +84,10 @@
 //! # Density ([`EnvironmentMap::pdf`])
 //!
 //! For a unit d: (u, v) = direction_to_uv(d), (i, j) the texel containing
-//! it, sin θ = sin(acos(clamp(d.y, −1, 1))); 0 if sin θ ≤ 0 (the poles, a
-//! set of measure zero) or the map is black; otherwise
+//! it, sin θ = √(d.x² + d.z²) (which is sin(acos(d.y)) for a unit d, but
+//! accurate near the poles, where acos of a rounded d.y is not — in f32
+//! badly so); 0 if sin θ ≤ 0 (the poles, a set of measure zero) or the map is
+//! black; otherwise
 //! p_ω = (marginal[j+1] − marginal[j]) (cond[j (W+1) + i + 1] − cond[j (W+1) + i]) W H / (2π² sin θ).
 //! It integrates to 1 over the sphere: Σ_ij P_ij W H ∫∫_texel du dv = Σ P_ij = 1.
 //!
@@ -347,13 +349,13 @@ impl EnvironmentMap {
     }
 
     /// The solid-angle density with which [`sample`](Self::sample) produces
-    /// the unit direction `d`: the texel's probability × W H / (2π² sin θ);
-    /// 0 where sin θ = 0 and for a black map.
+    /// the unit direction `d`: the texel's probability × W H / (2π² sin θ),
+    /// sin θ = √(d.x² + d.z²); 0 where sin θ = 0 and for a black map.
     pub fn pdf(&self, d: DVec3) -> f64 {
         if self.black {
             return 0.0;
         }
-        let sin_theta = d.y.clamp(-1.0, 1.0).acos().sin();
+        let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
         if sin_theta <= 0.0 {
             return 0.0;
         }

@@ -30,7 +30,9 @@ pub mod ggx;
 pub mod lights;
 pub mod warp;
 
-pub use bsdf::{reflect, refract, Bsdf, BsdfSample, Conductor, Diffuse, FresnelModel, Mirror, SmoothDielectric};
+pub use bsdf::{
+    reflect, refract, Bsdf, BsdfSample, Conductor, Diffuse, FresnelModel, Mirror, RoughDielectric, SmoothDielectric,
+};
 pub use envmap::{direction_to_uv, procedural_sky, uv_to_direction, EnvironmentMap};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, fresnel_schlick};
 pub use lights::{

@@ -13,9 +13,9 @@
 //! 2. Checks that involve more than one value (exactly one shape key per
 //!    object, material names, keys that fit a material's or light's `type`,
 //!    a conductor's one Fresnel form, a rect light's edges, the camera's
-//!    geometry, bounded surfaces) run on the raw tree, which keeps
-//!    `toml::Spanned` wrappers around the tables and values those checks
-//!    report on.
+//!    geometry, bounded surfaces, not both `background` and `[environment]`)
+//!    run on the raw tree, which keeps `toml::Spanned` wrappers around the
+//!    tables and values those checks report on.
 //!
 //! Array indices in field paths count from 0, as in `objects[0]`.
 
@@ -30,10 +30,11 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::{
-    Camera, ConductorFresnel, ImageSettings, Light, Material, MaterialKind, MaterialMaps, Scene, SceneObject,
-    TextureImage, UvMapping, UvSettings,
+    Camera, ConductorFresnel, EnvironmentMapSettings, ImageSettings, Light, Material, MaterialKind, MaterialMaps,
+    Scene, SceneObject, TextureImage, UvMapping, UvSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
+use crate::sampling::envmap::procedural_sky;
 use crate::texture::{self, TextureKind, TextureUsage, MAX_TEXTURE_SIZE};
 
 /// The file name used in messages about [`DEFAULT_SCENE`].
@@ -56,6 +57,8 @@ pub const MAX_SCATTER_COUNT: i64 = 1_000_000;
 pub const DEFAULT_MATERIAL_NAME: &str = "<default>";
 /// Largest accepted `count` of a generated `bumps` texture.
 pub const MAX_TEXTURE_BUMPS: i64 = 1_000_000;
+/// Largest accepted width of the generated sky (its height is at most half).
+pub const MAX_SKY_WIDTH: u32 = 4096;
 
 /// Why a scene could not be loaded. `Display` gives the whole message.
 #[derive(Debug, thiserror::Error)]
@@ -161,6 +164,15 @@ impl Source<'_> {
             message: message.into(),
             snippet,
         }
+    }
+
+    /// The line (from 1) of byte offset `pos`.
+    fn line_of(&self, pos: usize) -> usize {
+        let mut pos = pos.min(self.text.len());
+        while !self.text.is_char_boundary(pos) {
+            pos -= 1;
+        }
+        self.text[..pos].matches('\n').count() + 1
     }
 
     fn toml_error(&self, e: serde_path_to_error::Error<toml::de::Error>) -> SceneError {
@@ -501,37 +513,43 @@ impl<'de> Deserialize<'de> for Coefficients {
     }
 }
 
-/// The side of a generated texture: a power of two from 1 to
-/// [`MAX_TEXTURE_SIZE`].
+/// A power of two in `LO..=HI`: the side of a generated texture.
 #[derive(Clone, Copy, Debug)]
-struct TextureSize(u32);
+struct PowerOfTwo<const LO: u32, const HI: u32>(u32);
 
-struct TextureSizeVisitor;
+/// The side of a generated material map.
+type TextureSize = PowerOfTwo<1, MAX_TEXTURE_SIZE>;
+/// The width of the generated sky.
+type SkyWidth = PowerOfTwo<2, MAX_SKY_WIDTH>;
+/// The height of the generated sky.
+type SkyHeight = PowerOfTwo<1, { MAX_SKY_WIDTH / 2 }>;
 
-impl<'de> Visitor<'de> for TextureSizeVisitor {
-    type Value = TextureSize;
+struct PowerOfTwoVisitor<const LO: u32, const HI: u32>;
+
+impl<'de, const LO: u32, const HI: u32> Visitor<'de> for PowerOfTwoVisitor<LO, HI> {
+    type Value = PowerOfTwo<LO, HI>;
 
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "a power of two from 1 to {MAX_TEXTURE_SIZE}")
+        write!(f, "a power of two from {LO} to {HI}")
     }
 
-    fn visit_i64<E: de::Error>(self, v: i64) -> Result<TextureSize, E> {
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Self::Value, E> {
         match u32::try_from(v) {
-            Ok(n) if n.is_power_of_two() && n <= MAX_TEXTURE_SIZE => Ok(TextureSize(n)),
-            _ => Err(E::custom(format!(
-                "must be a power of two from 1 to {MAX_TEXTURE_SIZE}, such as 256, 512 or 1024 (got {v})"
-            ))),
+            Ok(n) if n.is_power_of_two() && (LO..=HI).contains(&n) => Ok(PowerOfTwo(n)),
+            _ => {
+                Err(E::custom(format!("must be a power of two from {LO} to {HI}, such as 256, 512 or 1024 (got {v})")))
+            }
         }
     }
 
-    fn visit_u64<E: de::Error>(self, v: u64) -> Result<TextureSize, E> {
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Self::Value, E> {
         self.visit_i64(i64::try_from(v).unwrap_or(i64::MAX))
     }
 }
 
-impl<'de> Deserialize<'de> for TextureSize {
+impl<'de, const LO: u32, const HI: u32> Deserialize<'de> for PowerOfTwo<LO, HI> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        d.deserialize_any(TextureSizeVisitor)
+        d.deserialize_any(PowerOfTwoVisitor::<LO, HI>)
     }
 }
 
@@ -630,34 +648,49 @@ impl<'de> Deserialize<'de> for ColourPair {
     }
 }
 
-/// A material's texture map: a file path, or a table naming a file or a
-/// generator.
-enum RawMap {
-    Path(String),
-    Table(Box<RawMapTable>),
+/// The table form of a map, as [`RawMap`] reads it.
+trait MapTable {
+    /// What the map accepts, for type errors.
+    const EXPECTING: &'static str;
 }
 
-struct RawMapVisitor;
+impl MapTable for RawMapTable {
+    const EXPECTING: &'static str =
+        "a file path such as \"textures/wood.png\" or a table such as { file = \"wood.png\" }";
+}
 
-impl<'de> Visitor<'de> for RawMapVisitor {
-    type Value = RawMap;
+impl MapTable for RawEnvironmentMapTable {
+    const EXPECTING: &'static str =
+        "a file path such as \"sky.exr\" or a table such as { sky = { width = 512, height = 256 } }";
+}
+
+/// A texture map: a file path, or a table `T` naming a file or a generator.
+enum RawMap<T = RawMapTable> {
+    Path(String),
+    Table(Box<T>),
+}
+
+struct RawMapVisitor<T>(PhantomData<T>);
+
+impl<'de, T: MapTable + Deserialize<'de>> Visitor<'de> for RawMapVisitor<T> {
+    type Value = RawMap<T>;
 
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str("a file path such as \"textures/wood.png\" or a table such as { file = \"wood.png\" }")
+        f.write_str(T::EXPECTING)
     }
 
-    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawMap, E> {
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawMap<T>, E> {
         Ok(RawMap::Path(v.to_owned()))
     }
 
-    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<RawMap, A::Error> {
-        RawMapTable::deserialize(de::value::MapAccessDeserializer::new(map)).map(|t| RawMap::Table(Box::new(t)))
+    fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<RawMap<T>, A::Error> {
+        T::deserialize(de::value::MapAccessDeserializer::new(map)).map(|t| RawMap::Table(Box::new(t)))
     }
 }
 
-impl<'de> Deserialize<'de> for RawMap {
+impl<'de, T: MapTable + Deserialize<'de>> Deserialize<'de> for RawMap<T> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        d.deserialize_any(RawMapVisitor)
+        d.deserialize_any(RawMapVisitor::<T>(PhantomData))
     }
 }
 
@@ -668,7 +701,8 @@ impl<'de> Deserialize<'de> for RawMap {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a scene table")]
 struct RawScene {
-    background: Option<Triple<NonNegative>>,
+    background: Option<Spanned<Triple<NonNegative>>>,
+    environment: Option<Spanned<RawEnvironment>>,
     image: Option<RawImage>,
     camera: Spanned<RawCamera>,
     #[serde(default)]
@@ -688,6 +722,30 @@ struct RawImage {
     seed: Option<Seed>,
     exposure: Option<Exposure>,
     max_depth: Option<Depth>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an [environment] table with a map")]
+struct RawEnvironment {
+    map: Spanned<RawMap<RawEnvironmentMapTable>>,
+    scale: Option<NonNegative>,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "an environment map table such as { file = \"sky.exr\" } or { sky = { width = 512, height = 256 } }"
+)]
+struct RawEnvironmentMapTable {
+    file: Option<Spanned<String>>,
+    sky: Option<Spanned<RawSky>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table such as { width = 512, height = 256 }")]
+struct RawSky {
+    width: SkyWidth,
+    height: SkyHeight,
 }
 
 #[derive(Deserialize)]
@@ -1011,7 +1069,25 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         max_depth: image.and_then(|i| i.max_depth).map_or(DEFAULT_MAX_DEPTH, |v| v.get() as u32),
     };
     let camera = build_camera(src, &raw.camera)?;
-    let background = raw.background.map_or(Vec3::ZERO, |b| b.get().as_vec3());
+    if let (Some(background), Some(environment)) = (&raw.background, &raw.environment) {
+        // Point at whichever comes second in the file.
+        let (b, e) = (background.span(), environment.span());
+        let ((field, span), (other, first)) = if e.start > b.start {
+            (("environment", e), ("background", b))
+        } else {
+            (("background", b), ("[environment]", e))
+        };
+        let line = src.line_of(first.start);
+        return Err(src.error(
+            Some(span),
+            field,
+            format!(
+                "give either background or [environment], not both: the environment map replaces the uniform \
+                 background as the light arriving from infinity ({other} is at line {line}); remove one"
+            ),
+        ));
+    }
+    let background = raw.background.as_ref().map_or(Vec3::ZERO, |b| b.get_ref().get().as_vec3());
 
     let mut textures = TextureCache::default();
     let mut materials: Vec<Material> = Vec::with_capacity(raw.materials.len() + 1);
@@ -1031,7 +1107,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
                 format!("duplicate material name {name:?} (first defined at line {line} as materials[{first}])"),
             ));
         }
-        material_lines.push(src.text[..span.start.min(src.text.len())].matches('\n').count() + 1);
+        material_lines.push(src.line_of(span.start));
         materials.push(build_material(src, i, raw_material, &mut textures)?);
     }
     let user_materials = materials.len();
@@ -1068,7 +1144,12 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
 
     let lights = raw.lights.iter().enumerate().map(|(i, l)| build_light(src, i, l)).collect::<Result<Vec<_>, _>>()?;
 
-    Ok(Scene { image, camera, background, materials, objects, lights, environment: None, textures: textures.images })
+    let environment = match &raw.environment {
+        Some(e) => Some(build_environment(src, e.get_ref(), &mut textures)?),
+        None => None,
+    };
+
+    Ok(Scene { image, camera, background, materials, objects, lights, environment, textures: textures.images })
 }
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {
@@ -1484,12 +1565,14 @@ struct TextureCache {
     keys: Vec<(String, TextureUsage, u32)>,
 }
 
-/// Where a map's texels come from.
+/// Where a map's texels come from: a file, or a generator (`Sky` is the
+/// environment's [`procedural_sky`]).
 enum MapSource {
     File { path: PathBuf },
     Checker { size: u32, cells: u32, colors: [[f32; 3]; 2] },
     Heights { size: u32, count: u32, seed: u32 },
     Normals { size: u32, count: u32, seed: u32, strength: f32 },
+    Sky { width: u32, height: u32 },
 }
 
 impl MapSource {
@@ -1500,6 +1583,7 @@ impl MapSource {
             Self::Checker { size, cells, colors } => format!("checker {size} {cells} {colors:?}"),
             Self::Heights { size, count, seed } => format!("heights {size} {count} {seed}"),
             Self::Normals { size, count, seed, strength } => format!("normals {size} {count} {seed} {strength:?}"),
+            Self::Sky { width, height } => format!("sky {width} {height}"),
         }
     }
 }
@@ -1508,17 +1592,28 @@ impl TextureCache {
     /// The index of the texture for `source` read as a `kind` map, loading
     /// or generating it on first use.
     fn get(&mut self, source: &MapSource, kind: TextureKind) -> Result<usize, texture::TextureError> {
-        let (key, usage) = (source.key(), kind.usage());
+        self.get_as(source, kind.usage(), |path, channels| kind.check_channels(path, channels))
+    }
+
+    /// The index of the texture for `source` read as `usage`, loading or
+    /// generating it on first use; `check` vets a file's colour channels.
+    fn get_as(
+        &mut self,
+        source: &MapSource,
+        usage: TextureUsage,
+        check: impl Fn(&Path, u32) -> Result<(), texture::TextureError>,
+    ) -> Result<usize, texture::TextureError> {
+        let key = source.key();
         if let Some(k) = self.keys.iter().position(|(k, u, _)| *k == key && *u == usage) {
             if let MapSource::File { path } = source {
-                kind.check_channels(path, self.keys[k].2)?;
+                check(path, self.keys[k].2)?;
             }
             return Ok(k);
         }
         let (image, channels) = match *source {
             MapSource::File { ref path } => {
                 let loaded = texture::load_texture_file(path, usage)?;
-                kind.check_channels(path, loaded.channels)?;
+                check(path, loaded.channels)?;
                 (loaded.image, loaded.channels)
             }
             MapSource::Checker { size, cells, colors: [a, b] } => (texture::checker(size, cells, a, b), 3),
@@ -1526,6 +1621,7 @@ impl TextureCache {
             MapSource::Normals { size, count, seed, strength } => {
                 (texture::normals_from_heights(&texture::bump_heights(size, count, seed), strength), 3)
             }
+            MapSource::Sky { width, height } => (procedural_sky(width, height), 3),
         };
         self.images.push(image);
         self.keys.push((key, usage, channels));
@@ -1693,6 +1789,61 @@ fn build_map(
         .get(&source, kind)
         .map_err(|e| src.error(Some(span), source_field, format!("cannot load the {}: {e}", kind.name())))?;
     Ok((index, scale))
+}
+
+/// The `[environment]` table: its map (a file read as colour, or the
+/// procedural sky) and its radiance scale.
+fn build_environment(
+    src: &Source,
+    raw: &RawEnvironment,
+    textures: &mut TextureCache,
+) -> Result<EnvironmentMapSettings, SceneError> {
+    const FIELD: &str = "environment.map";
+    let map = &raw.map;
+    let file = |path: &str, span: Range<usize>, field: &str| {
+        if path.is_empty() {
+            Err(src.error(Some(span), field, "the texture path must not be empty"))
+        } else {
+            Ok(MapSource::File { path: src.dir.join(path) })
+        }
+    };
+    // (source, span and field path for load errors)
+    let (source, span, field) = match map.get_ref() {
+        RawMap::Path(path) => (file(path, map.span(), FIELD)?, map.span(), FIELD.to_owned()),
+        RawMap::Table(t) => match (&t.file, &t.sky) {
+            (Some(f), None) => {
+                let field = format!("{FIELD}.file");
+                (file(f.get_ref(), f.span(), &field)?, f.span(), field)
+            }
+            (None, Some(sky)) => {
+                let (width, height) = (sky.get_ref().width.0, sky.get_ref().height.0);
+                (MapSource::Sky { width, height }, sky.span(), format!("{FIELD}.sky"))
+            }
+            (None, None) => {
+                return Err(src.error(
+                    Some(map.span()),
+                    FIELD,
+                    "the environment map needs exactly one of `file` and `sky`; found neither, e.g. \
+                     map = \"sky.exr\" or map = { sky = { width = 512, height = 256 } }",
+                ))
+            }
+            (Some(f), Some(sky)) => {
+                let (key, span) =
+                    if sky.span().start > f.span().start { ("sky", sky.span()) } else { ("file", f.span()) };
+                return Err(src.error(
+                    Some(span),
+                    format!("{FIELD}.{key}"),
+                    "the environment map needs exactly one of `file` and `sky`; found both",
+                ));
+            }
+        },
+    };
+    // Read like a colour map: PNG and JPEG are sRGB-decoded, EXR is linear;
+    // any number of channels will do (grey is replicated to RGB).
+    let texture = textures
+        .get_as(&source, TextureUsage::Color, |_, _| Ok(()))
+        .map_err(|e| src.error(Some(span), field, format!("cannot load the environment map: {e}")))?;
+    Ok(EnvironmentMapSettings { texture, scale: raw.scale.map_or(1.0, |s| s.get() as f32) })
 }
 
 /// The Fresnel term of a conductor from its one of `color`, `eta` with `k`,
@@ -2516,6 +2667,140 @@ mod tests {
         let e = material_error("type = \"conductor\"\nalbedo_map = \"a.png\"\n");
         assert!(e.contains("`albedo_map` does not apply to a conductor material"), "{e}");
         assert!(e.contains("belongs to type = \"diffuse\" or type = \"mirror\""), "{e}");
+    }
+
+    #[test]
+    fn environment_sky_and_scale() {
+        // No [environment]: none.
+        assert_eq!(parse("").environment, None);
+        let s = parse("[environment]\nmap = { sky = { width = 16, height = 8 } }\n");
+        assert_eq!(s.environment, Some(EnvironmentMapSettings { texture: 0, scale: 1.0 }));
+        assert_eq!(s.background, Vec3::ZERO);
+        assert_eq!(s.textures, [procedural_sky(16, 8)]);
+        // After the material maps; the scale is kept; any power-of-two sizes in range.
+        let s = parse(
+            "[[materials]]\nname = \"a\"\nalbedo_map = { checker = { size = 4, cells = 2, colors = [0, 1] } }\n\
+             [environment]\nscale = 0.25\nmap = { sky = { width = 2, height = 1 } }\n",
+        );
+        assert_eq!(s.environment, Some(EnvironmentMapSettings { texture: 1, scale: 0.25 }));
+        assert_eq!((s.textures[1].width, s.textures[1].height), (2, 1));
+        assert_eq!(s.materials[0].maps.albedo, Some(0));
+        let s = parse("[environment]\nmap = { sky = { width = 8, height = 8 } }\nscale = 0\n");
+        assert_eq!(s.environment, Some(EnvironmentMapSettings { texture: 0, scale: 0.0 }));
+        // The largest sky is accepted (read without generating it).
+        let largest: RawSky = toml::from_str("width = 4096\nheight = 2048").unwrap();
+        assert_eq!((largest.width.0, largest.height.0), (4096, 2048));
+        // The inline form, before the first table.
+        let s =
+            parse_scene(&format!("environment = {{ map = {{ sky = {{ width = 8, height = 4 }} }} }}\n{CAMERA}"), "t")
+                .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.environment, Some(EnvironmentMapSettings { texture: 0, scale: 1.0 }));
+    }
+
+    #[test]
+    fn environment_files() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("env")).unwrap();
+        write_png(&dir.path().join("env/grey.png"), 1, 128);
+        exr::prelude::write_rgb_file(dir.path().join("env/hdr.exr"), 4, 2, |x, _| (5.0f32, 0.5, x as f32)).unwrap();
+        let scene_file = dir.path().join("scene.toml").display().to_string();
+        let load = |body: &str| parse_scene(&format!("{CAMERA}{body}"), &scene_file);
+
+        // EXR: linear, values above 1 kept; the path is relative to the scene.
+        let s = load("[environment]\nmap = \"env/hdr.exr\"\nscale = 2\n").unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.environment, Some(EnvironmentMapSettings { texture: 0, scale: 2.0 }));
+        let t = &s.textures[0];
+        assert_eq!((t.width, t.height), (4, 2));
+        assert_eq!(t.levels[0][3], [5.0, 0.5, 3.0, 1.0]);
+        assert!(t.source.ends_with("hdr.exr"), "{}", t.source);
+
+        // PNG: sRGB-decoded like a colour map; the table form; shared with
+        // an albedo map of the same file, but not with a data map of it.
+        let s = load(
+            "[[materials]]\nname = \"a\"\ntype = \"conductor\"\nroughness_map = \"env/grey.png\"\n\
+             [[materials]]\nname = \"b\"\nalbedo_map = \"env/grey.png\"\n\
+             [environment]\nmap = { file = \"env/grey.png\" }\n",
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.materials[0].maps.roughness, Some(0));
+        assert_eq!(s.materials[1].maps.albedo, Some(1));
+        assert_eq!(s.environment, Some(EnvironmentMapSettings { texture: 1, scale: 1.0 }));
+        assert_eq!(s.textures.len(), 2);
+        assert!((s.textures[1].levels[0][0][0] - 0.215_860_5).abs() < 1e-6, "sRGB-decoded");
+        assert!((s.textures[0].levels[0][0][0] - 128.0 / 255.0).abs() < 1e-6, "as stored");
+
+        // A missing file names the field, the scene's line and column and the resolved path.
+        let e = load("[environment]\nmap = \"env/nope.exr\"\n").unwrap_err().to_string();
+        let missing = dir.path().join("env/nope.exr").display().to_string();
+        assert!(e.contains(":5:7: environment.map: cannot load the environment map: "), "{e}");
+        assert!(e.contains(&format!("{missing}: no such file")), "{e}");
+        let e = load("[environment]\nmap = { file = \"nope.png\" }\n").unwrap_err().to_string();
+        assert!(e.contains(":5:16: environment.map.file: cannot load the environment map: "), "{e}");
+    }
+
+    #[test]
+    fn environment_errors() {
+        let err = |body: &str| parse_scene(&format!("{CAMERA}{body}"), "t.toml").unwrap_err().to_string();
+        let sky = "map = { sky = { width = 8, height = 4 } }";
+
+        // Both background and [environment]: at the second.
+        let e = parse_scene(&format!("background = [1, 1, 1]\n{CAMERA}[environment]\n{sky}\n"), "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.toml:5:1: environment: give either background or [environment], not both"), "{e}");
+        assert!(e.contains("(background is at line 1)") && e.contains("\n5 | [environment]\n"), "{e}");
+        let e = parse_scene(&format!("environment = {{ {sky} }}\nbackground = [0, 0, 0]\n{CAMERA}"), "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.toml:2:14: background: give either background or [environment], not both"), "{e}");
+        assert!(e.contains("([environment] is at line 1)"), "{e}");
+
+        let e = err("[environment]\nmap = { sky = { width = 500, height = 256 } }\n");
+        assert!(e.starts_with("t.toml:5:25: environment.map.sky.width: must be a power of two from 2 to 4096"), "{e}");
+        assert!(e.contains("(got 500)"), "{e}");
+        let e = err("[environment]\nmap = { sky = { width = 1, height = 1 } }\n");
+        assert!(e.contains("environment.map.sky.width: must be a power of two from 2 to 4096"), "{e}");
+        let e = err("[environment]\nmap = { sky = { width = 8192, height = 4096 } }\n");
+        assert!(e.contains("environment.map.sky.width: must be a power of two from 2 to 4096"), "{e}");
+        let e = err("[environment]\nmap = { sky = { width = 8, height = 0 } }\n");
+        assert!(
+            e.contains("environment.map.sky.height: must be a power of two from 1 to 2048,") && e.contains("(got 0)"),
+            "{e}"
+        );
+        let e = err("[environment]\nmap = { sky = { width = 8 } }\n");
+        assert!(e.contains("environment.map.sky.height: the required key `height` is missing"), "{e}");
+        let e = err(&format!("[environment]\n{sky}\nscale = -1\n"));
+        assert!(e.starts_with("t.toml:6:9: environment.scale: must not be negative (got -1)"), "{e}");
+        let e = err(&format!("[environment]\n{sky}\nscale = inf\n"));
+        assert!(e.contains("environment.scale: must be a finite number"), "{e}");
+        let e = err(&format!("[environment]\n{sky}\nexposure = 1\n"));
+        assert!(e.starts_with("t.toml:6:1: environment.exposure: unknown field `exposure`"), "{e}");
+        let e = err("[environment]\nmap = { sky = { width = 8, height = 4, sun = 1 } }\n");
+        assert!(e.contains("environment.map.sky.sun: unknown field `sun`"), "{e}");
+        let e = err("[environment]\nmap = { checker = 1 }\n");
+        assert!(e.contains("environment.map.checker: unknown field `checker`, expected `file` or `sky`"), "{e}");
+        let e = err("[environment]\nscale = 1\n");
+        assert!(e.contains("environment.map: the required key `map` is missing"), "{e}");
+        let e = err("[environment]\nmap = {}\n");
+        assert!(
+            e.starts_with(
+                "t.toml:5:7: environment.map: the environment map needs exactly one of `file` and `sky`; found neither"
+            ),
+            "{e}"
+        );
+        let e = err("[environment]\nmap = { file = \"a.exr\", sky = { width = 8, height = 4 } }\n");
+        assert!(e.starts_with("t.toml:5:31: environment.map.sky: the environment map needs exactly one"), "{e}");
+        assert!(e.contains("found both"), "{e}");
+        let e = err("[environment]\nmap = \"\"\n");
+        assert!(e.contains("environment.map: the texture path must not be empty"), "{e}");
+        let e = err("[environment]\nmap = 3\n");
+        assert!(
+            e.contains("environment.map: invalid type: integer `3`, expected a file path such as \"sky.exr\""),
+            "{e}"
+        );
+        // A background written after [environment] lands in it; the message says so.
+        let e = err(&format!("[environment]\n{sky}\nbackground = [0, 0, 0]\n"));
+        assert!(e.contains("environment.background: unknown field") && e.contains("must come before"), "{e}");
     }
 
     #[test]
