@@ -97,7 +97,7 @@ vec3 environmentRadiance(vec3 d) {
 
 float environmentPdf(vec3 d) {
     if (!envMapped()) return 1.0 / (4.0 * PI);
-    float sinTheta = sqrt(max(0.0, 1.0 - d.y * d.y));
+    float sinTheta = sqrt(d.x * d.x + d.z * d.z);  // accurate near the poles, unlike sqrt(1 - y²)
     if (sinTheta <= 0.0) return 0.0;
     return envTexelProbability(envTexel(directionToUv(d))) * float(frame.envWidth * frame.envHeight)
          / (2.0 * PI * PI * sinTheta);
