@@ -277,13 +277,29 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, in
     return contribution * (w / ls.pdf);
 }
 
+// Nested dielectrics: the path keeps a stack of the dielectric materials it
+// is inside (innermost last). A dielectric surface is an interface between
+// its material and the medium on its other side: when the ray enters, the
+// medium it comes from (the top of the stack); when it leaves, the medium
+// below this material in the stack. Its relative index is the ratio of the
+// two. A transmission pushes the material (entering) or removes it
+// (leaving). This is right for properly nested objects (a bubble in glass,
+// glass in water); coincident or overlapping interfaces would need
+// priorities (Schmidt & Budge 2002). Paths start in vacuum (index 1).
+const uint MEDIA_STACK = 4u;
+
 vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
+    uint media[MEDIA_STACK];
+    uint mediaCount = 0u;
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
     float lastPdf = 0.0;      // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
     vec3 lastPoint = o;
     uint choices = lightChoices();
-    for (uint bounce = 0u; bounce < frame.maxDepth; ++bounce) {
+    // Crossing an index-matched interface (relative index 1: the same medium
+    // on both sides) is not a bounce; `step` bounds the loop all the same.
+    uint bounce = 0u;
+    for (uint step = 0u; bounce < frame.maxDepth && step < 4u * frame.maxDepth + 8u; ++step) {
         SceneHit h = traceScene(o, d, 0.0, 1e30);
         float tl;
         uint which = firstLightHit(o, d, h.object == NO_HIT ? 1e30 : h.t, frame.lightCount, tl);
@@ -301,6 +317,39 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         vec3 ns;
         Material mat = surfaceAt(h, ns);
         if (SHADING_MODE == SHADING_NONE) return v3(mat.albedo);
+        uint matIndex = objects[h.object].material;
+        bool entering = dot(d, h.normal) < 0.0;
+        if (mat.kind == MATERIAL_DIELECTRIC) {
+            // The medium on the far side of this interface.
+            float outside = 1.0;
+            if (entering) {
+                if (mediaCount > 0u) outside = materials[media[mediaCount - 1u]].ior;
+            } else {
+                for (uint k = mediaCount; k > 0u; --k) {
+                    if (media[k - 1u] == matIndex) {
+                        if (k > 1u) outside = materials[media[k - 2u]].ior;
+                        break;
+                    }
+                }
+            }
+            mat.ior /= outside;
+            if (abs(mat.ior - 1.0) < 1e-6) {
+                // Invisible interface: continue straight on, into or out of this medium.
+                if (entering) {
+                    if (mediaCount < MEDIA_STACK) media[mediaCount++] = matIndex;
+                } else {
+                    for (uint k = mediaCount; k > 0u; --k) {
+                        if (media[k - 1u] == matIndex) {
+                            for (uint j = k - 1u; j + 1u < mediaCount; ++j) media[j] = media[j + 1u];
+                            --mediaCount;
+                            break;
+                        }
+                    }
+                }
+                o = offsetOrigin(o + h.t * d, h.normal, d);
+                continue;
+            }
+        }
         vec3 p = o + h.t * d;
         radiance += throughput * v3(mat.emission);
         // Two-sided shading; dielectrics keep the outward normal to tell inside from outside.
@@ -313,6 +362,20 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
         if (!bs.valid) break;
+        if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) {
+            // Transmitted: update the stack of media.
+            if (entering) {
+                if (mediaCount < MEDIA_STACK) media[mediaCount++] = matIndex;
+            } else {
+                for (uint k = mediaCount; k > 0u; --k) {
+                    if (media[k - 1u] == matIndex) {
+                        for (uint j = k - 1u; j + 1u < mediaCount; ++j) media[j] = media[j + 1u];
+                        --mediaCount;
+                        break;
+                    }
+                }
+            }
+        }
         throughput *= bs.weight;
         lastPdf = bs.pdf;
         lastPoint = p;
@@ -324,6 +387,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
             if (rand(rng) > q) break;
             throughput /= q;
         }
+        ++bounce;
     }
     return radiance;
 }
