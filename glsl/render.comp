@@ -49,84 +49,23 @@ layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTU
 vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index)], uv, 0.0); }
 
 // ---- The environment map --------------------------------------------------
-// Lat-long, piecewise constant per texel, importance-sampled by luminance ×
-// sin θ with the marginal and conditional CDFs built on the CPU
-// (src/sampling/envmap.rs, the f64 twin, documents the conventions).
 layout(set = 0, binding = BINDING_ENV_CDF, scalar) readonly buffer EnvCdf { float envCdf[]; };
 
-bool envMapped() { return frame.envMap != NO_TEXTURE; }
-
-vec2 directionToUv(vec3 d) {
-    return vec2(atan(d.z, d.x) / (2.0 * PI) + 0.5, acos(clamp(d.y, -1.0, 1.0)) / PI);
-}
-
-vec3 uvToDirection(vec2 uv) {
-    float phi = 2.0 * PI * (uv.x - 0.5), theta = PI * uv.y;
-    return vec3(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
-}
-
-ivec2 envTexel(vec2 uv) {
-    return clamp(ivec2(floor(uv * vec2(frame.envWidth, frame.envHeight))), ivec2(0),
-                 ivec2(frame.envWidth, frame.envHeight) - 1);
-}
-
+float envCdfAt(uint i) { return envCdf[i]; }
 vec3 envTexelRadiance(ivec2 t) {
     return texelFetch(textures[nonuniformEXT(frame.envMap)], t, 0).rgb * frame.envScale;
 }
+#include "envmap.glsl"
 
-// Probability of texel t: its row's, times its column's within the row.
-float envTexelProbability(ivec2 t) {
-    uint w = frame.envWidth, h = frame.envHeight;
-    uint row = h + 1u + uint(t.y) * (w + 1u);
-    return (envCdf[t.y + 1] - envCdf[t.y]) * (envCdf[row + uint(t.x) + 1u] - envCdf[row + uint(t.x)]);
-}
-
-// The largest k in [0, n - 1] with envCdf[base + k] <= u.
-uint searchCdf(uint base, uint n, float u) {
-    uint lo = 0u, hi = n - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi + 1u) / 2u;
-        if (envCdf[base + mid] <= u) lo = mid; else hi = mid - 1u;
-    }
-    return lo;
-}
+bool envMapped() { return frame.envMap != NO_TEXTURE; }
 
 vec3 environmentRadiance(vec3 d) {
-    return envMapped() ? envTexelRadiance(envTexel(directionToUv(d))) : frame.background;
+    return envMapped() ? envTexelRadiance(envTexelAt(directionToUv(d), frame.envWidth, frame.envHeight))
+                       : frame.background;
 }
 
 float environmentPdf(vec3 d) {
-    if (!envMapped()) return 1.0 / (4.0 * PI);
-    float sinTheta = sqrt(d.x * d.x + d.z * d.z);  // accurate near the poles, unlike sqrt(1 - y²)
-    if (sinTheta <= 0.0) return 0.0;
-    return envTexelProbability(envTexel(directionToUv(d))) * float(frame.envWidth * frame.envHeight)
-         / (2.0 * PI * PI * sinTheta);
-}
-
-LightSample sampleEnvironmentMap(vec2 u) {
-    LightSample s;
-    s.valid = false;
-    s.dist = 1e30;
-    s.pdf = 0.0;
-    s.radiance = vec3(0.0);
-    s.wi = vec3(0.0, 1.0, 0.0);
-    uint w = frame.envWidth, h = frame.envHeight;
-    uint j = searchCdf(0u, h, u.x);
-    float pRow = envCdf[j + 1u] - envCdf[j];
-    uint row = h + 1u + j * (w + 1u);
-    uint i = searchCdf(row, w, u.y);
-    float pCol = envCdf[row + i + 1u] - envCdf[row + i];
-    if (pRow <= 0.0 || pCol <= 0.0) return s;
-    float fv = clamp((u.x - envCdf[j]) / pRow, 0.0, 1.0);
-    float fu = clamp((u.y - envCdf[row + i]) / pCol, 0.0, 1.0);
-    vec2 uv = vec2((float(i) + fu) / float(w), (float(j) + fv) / float(h));
-    float sinTheta = sin(PI * uv.y);
-    if (sinTheta <= 0.0) return s;
-    s.wi = uvToDirection(uv);
-    s.pdf = pRow * pCol * float(w * h) / (2.0 * PI * PI * sinTheta);
-    s.radiance = envTexelRadiance(ivec2(i, j));
-    s.valid = true;
-    return s;
+    return envMapped() ? envMapPdf(d, frame.envWidth, frame.envHeight) : 1.0 / (4.0 * PI);
 }
 
 // Height of a displacement map and its derivatives in (u, v), by central
@@ -218,7 +157,7 @@ bool environmentLit() { return frame.envMap != NO_TEXTURE || any(greaterThan(fra
 // background radiance) when it is not black.
 LightSample sampleLightOrEnvironment(uint i, vec3 x, vec2 u) {
     if (i != frame.lightCount) return sampleLight(lights[i], x, u);
-    return envMapped() ? sampleEnvironmentMap(u) : sampleEnvironment(frame.background, u);
+    return envMapped() ? sampleEnvMap(u, frame.envWidth, frame.envHeight) : sampleEnvironment(frame.background, u);
 }
 
 float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {

@@ -6,10 +6,24 @@
 
 #include "lights.glsl"
 
+layout(set = 0, binding = 2, scalar) readonly buffer EnvTable { float envTable[]; };
+layout(set = 0, binding = 3, scalar) readonly buffer EnvTexels { vec4 envTexels[]; };
+layout(push_constant, scalar) uniform Push {
+    uint count;
+    uint envWidth;
+    uint envHeight;
+    float envScale;
+} pc;
+
+float envCdfAt(uint i) { return envTable[i]; }
+vec3 envTexelRadiance(ivec2 t) { return envTexels[uint(t.y) * pc.envWidth + uint(t.x)].rgb * pc.envScale; }
+#include "envmap.glsl"
+
 layout(local_size_x = 64) in;
 
 const uint OP_BSDF = 0u;
 const uint OP_LIGHT = 1u;
+const uint OP_ENVIRONMENT = 2u;
 
 struct TwinCase {
     uint op;
@@ -33,7 +47,6 @@ struct TwinResult {
 
 layout(set = 0, binding = 0, scalar) readonly buffer Cases { TwinCase cases[]; };
 layout(set = 0, binding = 1, scalar) writeonly buffer Results { TwinResult results[]; };
-layout(push_constant, scalar) uniform Push { uint count; } pc;
 
 float[3] f3(vec3 v) { return float[3](v.x, v.y, v.z); }
 
@@ -54,6 +67,13 @@ void main() {
         r.valid = s.valid ? 1u : 0u;
         r.eval = f3(bsdfEval(c.mat, wo, wi));
         r.pdfOf = bsdfPdf(c.mat, wo, wi);
+    } else if (c.op == OP_ENVIRONMENT) {
+        LightSample s = sampleEnvMap(vec2(c.u[0], c.u[1]), pc.envWidth, pc.envHeight);
+        r.wi = f3(s.wi);
+        r.weight = f3(s.radiance);
+        r.pdf = s.pdf;
+        r.valid = s.valid ? 1u : 0u;
+        r.pdfOf = envMapPdf(v3(c.wi), pc.envWidth, pc.envHeight);
     } else {
         vec3 x = v3(c.x);
         LightSample s = sampleLight(c.light, x, vec2(c.u[0], c.u[1]));

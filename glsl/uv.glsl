@@ -32,7 +32,7 @@ SurfaceUv objectUv(Object obj, vec3 p) {
         if (obj.uvMapping == UV_SPHERICAL) {
             // Polar angle from +y: v = acos(y / r) / π.
             float r2 = max(dot(p, p), 1e-30);
-            s.uv.y = acos(clamp(p.y / sqrt(r2), -1.0, 1.0)) / UV_PI;
+            s.uv.y = atan(rho, p.y) / UV_PI;  // more accurate in f32 than acos(y / r)
             s.gradV = -(vec3(0.0, 1.0, 0.0) - p * (p.y / r2)) / (UV_PI * rho);
         } else {
             s.uv.y = p.y;

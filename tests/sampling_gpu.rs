@@ -60,18 +60,19 @@ const _: () = assert!(std::mem::size_of::<TwinCase>() == 4 + 84 + 56 + 48);
 const _: () = assert!(std::mem::size_of::<TwinResult>() == 52);
 
 fn run_twins(cases: &[TwinCase]) -> Vec<TwinResult> {
+    run_twins_with(cases, None)
+}
+
+/// Runs the twin shader; `env` gives an environment map (its table, texels,
+/// width, height, scale) for the environment cases.
+fn run_twins_with(cases: &[TwinCase], env: Option<(&[f32], &[[f32; 4]], u32, u32, f32)>) -> Vec<TwinResult> {
     let ctx = common::context();
     let counters = ctx.counters();
     let results = {
         let device = &ctx.device;
-        let pipeline = ComputePipeline::new(
-            device,
-            &quadray::shaders::twins(),
-            &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
-            4,
-            &[],
-        )
-        .unwrap();
+        let pipeline =
+            ComputePipeline::new(device, &quadray::shaders::twins(), &[BindingKind::StorageBuffer; 4], 16, &[])
+                .unwrap();
         let input = Buffer::with_data(device, "twin cases", cases, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
         let output = Buffer::new(
             device,
@@ -81,10 +82,20 @@ fn run_twins(cases: &[TwinCase]) -> Vec<TwinResult> {
             MemoryLocation::GpuToCpu,
         )
         .unwrap();
-        pipeline.bind(&[Binding::Buffer(&input), Binding::Buffer(&output)]);
+        let (table, texels, w, h, scale) = env.unwrap_or((&[0.0], &[[0.0; 4]], 1, 1, 0.0));
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let table = Buffer::with_data(device, "environment table", table, usage).unwrap();
+        let texels = Buffer::with_data(device, "environment texels", texels, usage).unwrap();
+        pipeline.bind(&[
+            Binding::Buffer(&input),
+            Binding::Buffer(&output),
+            Binding::Buffer(&table),
+            Binding::Buffer(&texels),
+        ]);
         let mut cmds = Commands::new(device).unwrap();
         let count = cases.len() as u32;
-        cmds.run(|_, cmd| pipeline.dispatch(cmd, bytemuck::bytes_of(&count), [count.div_ceil(64), 1, 1])).unwrap();
+        let push: [u32; 4] = [count, w, h, scale.to_bits()];
+        cmds.run(|_, cmd| pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1])).unwrap();
         let mut r: Vec<TwinResult> = output.read();
         r.truncate(cases.len());
         r
@@ -349,4 +360,78 @@ fn gpu_light_sampling_matches_the_cpu_twin() {
     }
     assert!(failures.is_empty(), "{} disagreements", failures.len());
     assert!(share <= MAX_EDGE_SHARE, "too many rim cases: {share}");
+}
+
+#[test]
+fn gpu_environment_map_sampling_matches_the_cpu_twin() {
+    use quadray::sampling::envmap::{procedural_sky, EnvironmentMap};
+    let sky = procedural_sky(64, 32);
+    let map = EnvironmentMap::from_texture(&sky, 0.5);
+    let table = map.cdf_buffer();
+    let texels: Vec<[f32; 4]> = map.texels.iter().map(|t| [t[0], t[1], t[2], 1.0]).collect();
+    let mut rng = Pcg64::seed_from_u64(13);
+    let mut cases = Vec::new();
+    for _ in 0..20_000 {
+        let wi = d3(f3(random_dir(&mut rng, false)));
+        cases.push(TwinCase {
+            op: 2,
+            mat: GpuMaterial::default(),
+            light: GpuLight::default(),
+            wo: [0.0; 3],
+            wi: f3(wi),
+            u: [rng.gen::<f32>(), rng.gen::<f32>(), 0.0],
+            x: [0.0; 3],
+        });
+    }
+    let results = run_twins_with(&cases, Some((&table, &texels, map.width, map.height, map.scale)));
+    let (mut compared, mut edge, mut worst_dir, mut worst_pdf) = (0, 0, 0f64, 0f64);
+    let mut failures = Vec::new();
+    for (c, r) in cases.iter().zip(&results) {
+        let (u1, u2) = (c.u[0] as f64, c.u[1] as f64);
+        let wi = d3(c.wi).normalize();
+        // Densities at given directions: a direction within 1e-4 texel of a
+        // texel border may fall in either texel in f32.
+        let uv = quadray::sampling::envmap::direction_to_uv(wi);
+        let border = |x: f64, n: u32| ((x * n as f64) - (x * n as f64).round()).abs() < 1e-4;
+        if border(uv.x, map.width) || border(uv.y, map.height) {
+            edge += 1;
+        } else {
+            let p = map.pdf(wi);
+            worst_pdf = worst_pdf.max(rel(p, r.pdf_of as f64));
+            if rel(p, r.pdf_of as f64) > REL_TOL {
+                failures.push(format!("pdf at {wi:?}: cpu {p}, gpu {}", r.pdf_of));
+            }
+        }
+        match (map.sample(u1, u2), r.valid != 0) {
+            (None, false) => compared += 1,
+            (Some((dir, pdf, radiance)), true) => {
+                // A sample at the boundary between two CDF entries may pick
+                // the neighbouring texel in f32.
+                if rel3(radiance, d3(r.weight)) > REL_TOL && (dir - d3(r.wi)).length() < 0.2 {
+                    edge += 1;
+                    continue;
+                }
+                compared += 1;
+                let dd = (dir - d3(r.wi)).length();
+                worst_dir = worst_dir.max(dd);
+                worst_pdf = worst_pdf.max(rel(pdf, r.pdf as f64));
+                if dd > DIR_TOL || rel(pdf, r.pdf as f64) > REL_TOL || rel3(radiance, d3(r.weight)) > REL_TOL {
+                    failures.push(format!("sample u=({u1}, {u2}): cpu {dir:?} {pdf} {radiance:?}, gpu {r:?}"));
+                }
+            }
+            (cpu, _) => failures.push(format!("validity u=({u1}, {u2}): cpu {cpu:?}, gpu {r:?}")),
+        }
+    }
+    let share = edge as f64 / cases.len() as f64;
+    println!(
+        "environment map twins: {} cases, {compared} samples compared, {edge} on a texel or CDF border \
+         ({:.4}%); worst: direction {worst_dir:.2e} (bound {DIR_TOL:e}), pdf {worst_pdf:.2e} (bound {REL_TOL:e})",
+        cases.len(),
+        100.0 * share
+    );
+    for f in failures.iter().take(5) {
+        println!("  {f}");
+    }
+    assert!(failures.is_empty(), "{} disagreements", failures.len());
+    assert!(share <= MAX_EDGE_SHARE, "too many border cases: {share}");
 }
