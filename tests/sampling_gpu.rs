@@ -63,9 +63,12 @@ fn run_twins(cases: &[TwinCase]) -> Vec<TwinResult> {
     run_twins_with(cases, None)
 }
 
-/// Runs the twin shader; `env` gives an environment map (its table, texels,
-/// width, height, scale) for the environment cases.
-fn run_twins_with(cases: &[TwinCase], env: Option<(&[f32], &[[f32; 4]], u32, u32, f32)>) -> Vec<TwinResult> {
+/// An environment map for the twin shader: its CDF table, texels, width,
+/// height and scale.
+type TwinEnvironment<'a> = (&'a [f32], &'a [[f32; 4]], u32, u32, f32);
+
+/// Runs the twin shader, with an environment map for the environment cases.
+fn run_twins_with(cases: &[TwinCase], env: Option<TwinEnvironment<'_>>) -> Vec<TwinResult> {
     let ctx = common::context();
     let counters = ctx.counters();
     let results = {
