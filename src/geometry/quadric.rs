@@ -102,6 +102,21 @@ impl Quadric {
         scale == 0.0 || k[..9].iter().all(|v| v.abs() <= 1e-12 * scale)
     }
 
+    /// When A is negative definite, `{q >= 0}` is the ellipsoid
+    /// (p - m)ᵀ(-A)(p - m) <= q(m) around m = -A⁻¹b/2: `Some(Some(..))`, or
+    /// `Some(None)` when q(m) < 0 (the set is empty). `None` when A is not
+    /// negative definite (the set is unbounded or degenerate).
+    fn ellipsoid_support(&self) -> Option<Option<EllipsoidSupport>> {
+        let neg = -self.a;
+        if !is_positive_definite(&neg) {
+            return None;
+        }
+        let inverse = neg.inverse();
+        let centre = 0.5 * (inverse * self.b);
+        let top = self.eval(centre);
+        Some((top >= 0.0).then_some(EllipsoidSupport { inverse, centre, top }))
+    }
+
     /// Bounding box of `{q >= 0}` when that set is bounded: `Some(None)` when
     /// it is empty, `Some(Some(box))` when bounded, `None` when unbounded.
     ///
@@ -109,16 +124,7 @@ impl Quadric {
     /// ellipsoid (p - m)ᵀ(-A)(p - m) <= q(m) around m = -A⁻¹b/2, whose box
     /// half-extents are sqrt(q(m) · ((-A)⁻¹)_kk).
     pub fn support_bounds(&self) -> Option<Option<Aabb>> {
-        let neg = -self.a;
-        if !is_positive_definite(&neg) {
-            return None;
-        }
-        let inv = neg.inverse();
-        let centre = 0.5 * (inv * self.b);
-        let top = self.eval(centre);
-        if top < 0.0 {
-            return Some(None);
-        }
+        let Some(EllipsoidSupport { inverse: inv, centre, top }) = self.ellipsoid_support()? else { return Some(None) };
         let half = DVec3::new(
             (top * inv.x_axis.x).max(0.0).sqrt(),
             (top * inv.y_axis.y).max(0.0).sqrt(),
@@ -133,16 +139,7 @@ impl Quadric {
     /// and not empty. The radius is sqrt(q(m) · λ_max((-A)⁻¹)), with the
     /// eigenvalue found by power iteration and rounded up.
     pub fn support_sphere(&self) -> Option<(DVec3, f64)> {
-        let neg = -self.a;
-        if !is_positive_definite(&neg) {
-            return None;
-        }
-        let inv = neg.inverse();
-        let centre = 0.5 * (inv * self.b);
-        let top = self.eval(centre);
-        if top < 0.0 {
-            return None;
-        }
+        let EllipsoidSupport { inverse: inv, centre, top } = self.ellipsoid_support()??;
         let mut v = DVec3::new(1.0, 0.7, 0.3);
         let mut lambda = 0.0;
         for _ in 0..100 {
@@ -202,6 +199,16 @@ fn quadratic_range(g: f64, a: f64, e: f64) -> (f64, f64) {
         }
     }
     (lo, hi)
+}
+
+/// The ellipsoid {q >= 0} of a quadric with negative definite A.
+struct EllipsoidSupport {
+    /// (-A)⁻¹.
+    inverse: DMat3,
+    /// Its centre m = -A⁻¹b/2.
+    centre: DVec3,
+    /// q(m) >= 0.
+    top: f64,
 }
 
 fn is_positive_definite(m: &DMat3) -> bool {
