@@ -8,6 +8,7 @@
 //! - [`passes`]: GPU passes.
 //! - [`output`]: PNG and EXR files, written atomically.
 
+pub mod covariance;
 pub mod geometry;
 pub mod output;
 pub mod passes;
