@@ -48,6 +48,16 @@ layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTU
 
 vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index)], uv, 0.0); }
 
+#include "texfilter.glsl"
+
+// Specialisation constant: FILTER_NONE or FILTER_RAY_CONES.
+layout(constant_id = 2) const uint FILTER_MODE = FILTER_NONE;
+
+// A texture lookup over a footprint; FILTER_NONE ignores the footprint.
+vec4 lookup(uint index, Footprint fp) {
+    return FILTER_MODE == FILTER_NONE ? mapAt(index, fp.uv) : ewaLookup(index, fp);
+}
+
 // ---- The environment map --------------------------------------------------
 layout(set = 0, binding = BINDING_ENV_CDF, scalar) readonly buffer EnvCdf { float envCdf[]; };
 
@@ -79,8 +89,11 @@ vec3 heightAndSlopes(uint index, vec2 uv) {
 }
 
 // The material at a hit with its texture maps applied, and the shading normal
-// (outward, tilted by the normal and displacement maps).
-Material surfaceAt(SceneHit h, out vec3 shadingNormal) {
+// (outward, tilted by the normal and displacement maps). `d` is the ray's
+// direction and `sigma` the standard deviation (world units, across the
+// ray) of the ray's footprint there: texture lookups average over it,
+// stretched along the surface by the foreshortening.
+Material surfaceAt(SceneHit h, vec3 d, float sigma, out vec3 shadingNormal) {
     Object obj = objects[h.object];
     Material mat = materials[obj.material];
     shadingNormal = h.normal;
@@ -89,17 +102,27 @@ Material surfaceAt(SceneHit h, out vec3 shadingNormal) {
         return mat;
     }
     SurfaceUv s = objectUv(obj, h.objectPoint);
-    if (mat.albedoMap != NO_TEXTURE) {
-        vec3 a = v3(mat.albedo) * mapAt(mat.albedoMap, s.uv).rgb;
-        mat.albedo = float[3](a.x, a.y, a.z);
-    }
-    if (mat.roughnessMap != NO_TEXTURE) mat.roughness = clamp(mapAt(mat.roughnessMap, s.uv).r, 0.0, 1.0);
-    if (mat.normalMap == NO_TEXTURE && mat.displacementMap == NO_TEXTURE) return mat;
-
-    // World-space gradients of u and v, then the tangents.
+    // World-space gradients of u and v.
     vec3 n = h.normal;
     vec3 gu = transpose(h.worldToObject) * s.gradU;
     vec3 gv = transpose(h.worldToObject) * s.gradV;
+    // The footprint: σ across the ray, σ / |cos θ| along the surface in the
+    // plane of incidence (stretch bounded at 20), mapped to (u, v).
+    Footprint fp;
+    fp.uv = s.uv;
+    vec3 along = d - n * dot(n, d);
+    float al = length(along);
+    vec3 t1 = al > 1e-6 ? along / al : frameAround(n)[0];
+    vec3 t2 = cross(n, t1);
+    vec3 w1 = t1 * (sigma / max(abs(dot(d, n)), 0.05)), w2 = t2 * sigma;
+    fp.axis1 = vec2(dot(gu, w1), dot(gv, w1));
+    fp.axis2 = vec2(dot(gu, w2), dot(gv, w2));
+    if (mat.albedoMap != NO_TEXTURE) {
+        vec3 a = v3(mat.albedo) * lookup(mat.albedoMap, fp).rgb;
+        mat.albedo = float[3](a.x, a.y, a.z);
+    }
+    if (mat.roughnessMap != NO_TEXTURE) mat.roughness = clamp(lookup(mat.roughnessMap, fp).r, 0.0, 1.0);
+    if (mat.normalMap == NO_TEXTURE && mat.displacementMap == NO_TEXTURE) return mat;
     vec3 dpdu, dpdv;
     tangentsFromGradients(gu, gv, n, dpdu, dpdv);
     if (mat.displacementMap != NO_TEXTURE) {
@@ -110,7 +133,7 @@ Material surfaceAt(SceneHit h, out vec3 shadingNormal) {
         if (len > 0.0) n = dot(bent, n) >= 0.0 ? bent / len : -bent / len;
     }
     if (mat.normalMap != NO_TEXTURE) {
-        vec3 c = mapAt(mat.normalMap, s.uv).rgb * 2.0 - 1.0;
+        vec3 c = lookup(mat.normalMap, fp).rgb * 2.0 - 1.0;
         vec3 t = dpdu - n * dot(n, dpdu);
         float tl = length(t);
         mat3 f = frameAround(n);
@@ -230,6 +253,13 @@ const uint MEDIA_STACK = 4u;
 vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
     uint media[MEDIA_STACK];
     uint mediaCount = 0u;
+    // Ray cone (Akenine-Möller et al., "Improved Shader and Texture Level of
+    // Detail Using Ray Cones", JCGT 2021): width at the ray's origin and
+    // spread angle, starting from the pixel's angle at the camera. Rough and
+    // diffuse bounces widen the spread by twice their lobe's angular width
+    // (GGX α, 1 rad for Lambert): a heuristic; surface curvature is ignored.
+    float coneWidth = 0.0;
+    float coneSpread = 2.0 * length(frame.up) / float(frame.height);
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
     float lastPdf = 0.0;      // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
@@ -254,7 +284,9 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         }
 
         vec3 ns;
-        Material mat = surfaceAt(h, ns);
+        float width = coneWidth + coneSpread * h.t;
+        // A box of width w has σ = w / √12.
+        Material mat = surfaceAt(h, d, width * 0.28867513, ns);
         if (SHADING_MODE == SHADING_NONE) return v3(mat.albedo);
         uint matIndex = objects[h.object].material;
         bool entering = dot(d, h.normal) < 0.0;
@@ -301,6 +333,8 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
         if (!bs.valid) break;
+        coneWidth = width;
+        if (!isDelta(mat)) coneSpread += 2.0 * (mat.kind == MATERIAL_DIFFUSE ? 1.0 : materialAlpha(mat));
         if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) {
             // Transmitted: update the stack of media.
             if (entering) {
@@ -347,7 +381,8 @@ void main() {
         vec3 n = h.normal;
         aov.normal = float[3](n.x, n.y, n.z);
         vec3 ns;
-        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, ns).albedo);
+        float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * 0.28867513;
+        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, sigma, ns).albedo);
         aov.albedo = float[3](alb.x, alb.y, alb.z);
         aovs[idx] = aov;
     }

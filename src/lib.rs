@@ -51,8 +51,19 @@ pub fn render_scene(
     scene: &scene::Scene,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<passes::RenderOutput, RenderError> {
+    render_scene_with(ctx, scene, Default::default(), progress)
+}
+
+/// [`render_scene`] with a variant of the render shader (texture filtering,
+/// benchmark breakdowns).
+pub fn render_scene_with(
+    ctx: &vk::Context,
+    scene: &scene::Scene,
+    variant: passes::RenderVariant,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<passes::RenderOutput, RenderError> {
     let mut cmds = vk::Commands::new(&ctx.device)?;
     let gpu = passes::GpuScene::new(&ctx.device, &mut cmds, scene, &geometry::CellParams::default())?;
     let im = &scene.image;
-    passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), Default::default(), progress)
+    passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), variant, progress)
 }

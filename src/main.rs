@@ -55,6 +55,11 @@ struct RenderArgs {
     /// Print progress even when stderr is not a terminal.
     #[arg(long)]
     progress: bool,
+    /// Texture filtering: `none` (bilinear lookups of the finest mip level; with
+    /// many samples per pixel, the reference) or `ray-cones` (EWA lookups over
+    /// ray-cone footprints, Akenine-Möller et al. 2021).
+    #[arg(long, value_enum, default_value_t = Filter::None)]
+    filter: Filter,
     /// Benchmark mode: after an untimed warm-up (lavapipe compiles shaders at
     /// their first dispatch), time the render and variants of it with parts of
     /// the work switched off (perturbation root finding, shading and
@@ -62,6 +67,25 @@ struct RenderArgs {
     /// write the full render's outputs.
     #[arg(long)]
     bench: bool,
+}
+
+/// Texture filtering modes of `--filter`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Filter {
+    /// Bilinear lookups of mip level 0.
+    #[default]
+    None,
+    /// Ray cones with EWA lookups.
+    RayCones,
+}
+
+impl Filter {
+    fn constant(self) -> u32 {
+        match self {
+            Self::None => quadray::shader_interface::FILTER_NONE,
+            Self::RayCones => quadray::shader_interface::FILTER_RAY_CONES,
+        }
+    }
 }
 
 /// Which files `-o` asks for.
@@ -157,11 +181,13 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
+    let filter = args.filter.constant();
     let out = if args.bench {
-        bench(&ctx, &scene)?
+        bench(&ctx, &scene, filter)?
     } else {
         let mut progress = ProgressLine::new(args.progress);
-        let out = quadray::render_scene(&ctx, &scene, &mut |d, t| progress.update(d, t));
+        let variant = quadray::passes::RenderVariant { filter, ..Default::default() };
+        let out = quadray::render_scene_with(&ctx, &scene, variant, &mut |d, t| progress.update(d, t));
         progress.finish();
         out.context("render failed")?
     };
@@ -197,7 +223,7 @@ fn render(args: RenderArgs) -> Result<()> {
 }
 
 /// The benchmark mode of `render --bench`; returns the full render.
-fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray::passes::RenderOutput> {
+fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> Result<quadray::passes::RenderOutput> {
     use quadray::passes::{render, GpuScene, RenderVariant};
     use quadray::shader_interface::{INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, SHADING_FULL, SHADING_NONE};
     let device = &ctx.device;
@@ -205,12 +231,12 @@ fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray::passes::R
     let gpu = GpuScene::new(device, &mut cmds, scene, &quadray::geometry::CellParams::default())?;
     let im = &scene.image;
     let variants = [
-        ("full render", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_FULL }),
-        ("perturbation root finding off", RenderVariant { intersect: INTERSECT_BASE, shading: SHADING_FULL }),
-        ("shading and secondary rays off", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_NONE }),
+        ("full render", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter }),
+        ("perturbation root finding off", RenderVariant { intersect: INTERSECT_BASE, shading: SHADING_FULL, filter }),
+        ("shading and secondary rays off", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_NONE, filter }),
         (
             "traversal only (boxes are hits, no shading)",
-            RenderVariant { intersect: INTERSECT_BOXES, shading: SHADING_NONE },
+            RenderVariant { intersect: INTERSECT_BOXES, shading: SHADING_NONE, filter },
         ),
     ];
     eprintln!(

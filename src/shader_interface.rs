@@ -77,3 +77,8 @@ pub const INTERSECT_BASE: u32 = 2;
 pub const SHADING_FULL: u32 = 0;
 /// Shading mode: the first hit's albedo only (benchmark breakdowns).
 pub const SHADING_NONE: u32 = 1;
+/// Texture filtering: bilinear lookups of mip level 0 (with many samples per
+/// pixel, the brute-force reference).
+pub const FILTER_NONE: u32 = 0;
+/// Texture filtering: ray cones (Akenine-Möller et al. 2021) with EWA lookups.
+pub const FILTER_RAY_CONES: u32 = 1;

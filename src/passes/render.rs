@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::gpu::{GpuAov, GpuFrame, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use crate::scene::Scene;
-use crate::shader_interface::{INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
+use crate::shader_interface::{FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
 use crate::vk::{
     full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation,
 };
@@ -46,11 +46,13 @@ pub struct RenderVariant {
     /// `SHADING_FULL` or `SHADING_NONE` (the first hit's albedo: no light
     /// sampling, no shadow rays, no bounces).
     pub shading: u32,
+    /// Texture filtering: `FILTER_NONE` or `FILTER_RAY_CONES`.
+    pub filter: u32,
 }
 
 impl Default for RenderVariant {
     fn default() -> Self {
-        Self { intersect: INTERSECT_FULL, shading: SHADING_FULL }
+        Self { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter: FILTER_NONE }
     }
 }
 
@@ -118,7 +120,7 @@ pub fn render(
         &shaders::render(),
         &kinds,
         std::mem::size_of::<RenderPush>() as u32,
-        &[variant.intersect, variant.shading],
+        &[variant.intersect, variant.shading, variant.filter],
     )?;
     let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
     pipeline.bind(&[
