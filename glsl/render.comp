@@ -50,7 +50,9 @@ vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index
 
 #include "texfilter.glsl"
 
-// Specialisation constant: FILTER_NONE or FILTER_RAY_CONES.
+#include "covariance.glsl"
+
+// Specialisation constant: FILTER_NONE, FILTER_RAY_CONES or FILTER_COVARIANCE.
 layout(constant_id = 2) const uint FILTER_MODE = FILTER_NONE;
 
 // A texture lookup over a footprint; FILTER_NONE ignores the footprint.
@@ -88,12 +90,28 @@ vec3 heightAndSlopes(uint index, vec2 uv) {
     return vec3(h, dhdu, dhdv);
 }
 
+// The tangent basis of a hit for footprints: t1 along the ray's projection
+// on the surface, t2 = n × t1.
+void footprintBasis(vec3 d, vec3 n, out vec3 t1, out vec3 t2) {
+    vec3 along = d - n * dot(n, d);
+    float al = length(along);
+    t1 = al > 1e-6 ? along / al : frameAround(n)[0];
+    t2 = cross(n, t1);
+}
+
+// A ray cone's footprint on the surface, in the basis (t1, t2): σ across the
+// ray, σ / |cos θ| along t1 (stretch bounded at 20).
+mat2 coneFootprint(vec3 d, vec3 n, float sigma) {
+    float inv = 1.0 / max(abs(dot(d, n)), 0.05);
+    return mat2(sigma * sigma * inv * inv, 0.0, 0.0, sigma * sigma);
+}
+
 // The material at a hit with its texture maps applied, and the shading normal
 // (outward, tilted by the normal and displacement maps). `d` is the ray's
-// direction and `sigma` the standard deviation (world units, across the
-// ray) of the ray's footprint there: texture lookups average over it,
-// stretched along the surface by the foreshortening.
-Material surfaceAt(SceneHit h, vec3 d, float sigma, out vec3 shadingNormal) {
+// direction and `footprint` the covariance of the ray's footprint on the
+// surface (world units, in the basis of footprintBasis): texture lookups
+// average over it.
+Material surfaceAt(SceneHit h, vec3 d, mat2 footprint, out vec3 shadingNormal) {
     Object obj = objects[h.object];
     Material mat = materials[obj.material];
     shadingNormal = h.normal;
@@ -106,15 +124,17 @@ Material surfaceAt(SceneHit h, vec3 d, float sigma, out vec3 shadingNormal) {
     vec3 n = h.normal;
     vec3 gu = transpose(h.worldToObject) * s.gradU;
     vec3 gv = transpose(h.worldToObject) * s.gradV;
-    // The footprint: σ across the ray, σ / |cos θ| along the surface in the
-    // plane of incidence (stretch bounded at 20), mapped to (u, v).
+    // The footprint mapped to (u, v): with footprint = L Lᵀ (Cholesky), the
+    // columns of L, taken through the Jacobian [∇u; ∇v] on (t1, t2), are
+    // semi-axes whose outer products sum to the footprint's covariance in (u, v).
     Footprint fp;
     fp.uv = s.uv;
-    vec3 along = d - n * dot(n, d);
-    float al = length(along);
-    vec3 t1 = al > 1e-6 ? along / al : frameAround(n)[0];
-    vec3 t2 = cross(n, t1);
-    vec3 w1 = t1 * (sigma / max(abs(dot(d, n)), 0.05)), w2 = t2 * sigma;
+    vec3 t1, t2;
+    footprintBasis(d, n, t1, t2);
+    float l11 = sqrt(max(footprint[0][0], 0.0));
+    float l21 = l11 > 0.0 ? footprint[0][1] / l11 : 0.0;
+    float l22 = sqrt(max(footprint[1][1] - l21 * l21, 0.0));
+    vec3 w1 = t1 * l11 + t2 * l21, w2 = t2 * l22;
     fp.axis1 = vec2(dot(gu, w1), dot(gv, w1));
     fp.axis2 = vec2(dot(gu, w2), dot(gv, w2));
     if (mat.albedoMap != NO_TEXTURE) {
@@ -259,7 +279,10 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
     // diffuse bounces widen the spread by twice their lobe's angular width
     // (GGX α, 1 rad for Lambert): a heuristic; surface curvature is ignored.
     float coneWidth = 0.0;
-    float coneSpread = 2.0 * length(frame.up) / float(frame.height);
+    float pixelAngle = 2.0 * length(frame.up) / float(frame.height);
+    float coneSpread = pixelAngle;
+    // Covariance footprints (FILTER_COVARIANCE), from the pixel's filter.
+    PathCovariance cov = covCamera(d, normalize(frame.up), pixelAngle);
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
     float lastPdf = 0.0;      // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
@@ -285,8 +308,17 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
 
         vec3 ns;
         float width = coneWidth + coneSpread * h.t;
-        // A box of width w has σ = w / √12.
-        Material mat = surfaceAt(h, d, width * 0.28867513, ns);
+        mat2 footprint;
+        vec3 ct1, ct2;
+        float covInv = 1.0;
+        if (FILTER_MODE == FILTER_COVARIANCE) {
+            covTravel(cov, h.t);
+            footprint = covOnSurface(cov, d, h.normal, ct1, ct2, covInv);
+        } else {
+            // A box of width w has σ = w / √12.
+            footprint = coneFootprint(d, h.normal, width * 0.28867513);
+        }
+        Material mat = surfaceAt(h, d, footprint, ns);
         if (SHADING_MODE == SHADING_NONE) return v3(mat.albedo);
         uint matIndex = objects[h.object].material;
         bool entering = dot(d, h.normal) < 0.0;
@@ -335,6 +367,21 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         if (!bs.valid) break;
         coneWidth = width;
         if (!isDelta(mat)) coneSpread += 2.0 * (mat.kind == MATERIAL_DIFFUSE ? 1.0 : materialAlpha(mat));
+        if (FILTER_MODE == FILTER_COVARIANCE) {
+            vec3 wiWorld = normalize(frameW * bs.wi);
+            bool transmitted = bs.wi.z * wo.z < 0.0;
+            float sx = 1.0, sy = 1.0;
+            if (transmitted) {
+                // Angles scale by η cos θi / cos θt and η, with η = n_i / n_t.
+                float eta = wo.z > 0.0 ? 1.0 / mat.ior : mat.ior;
+                sx = eta * abs(wo.z) / max(abs(bs.wi.z), 0.05);
+                sy = eta;
+            }
+            // Angular standard deviation of the lobe: about √2 α for GGX
+            // reflection, about 0.6 rad for Lambert, 0 for delta lobes.
+            float lobe = isDelta(mat) ? 0.0 : (mat.kind == MATERIAL_DIFFUSE ? 0.6 : 1.41421356 * materialAlpha(mat));
+            covBounce(cov, covInv, ct1, ct2, wiWorld, sx, sy, lobe);
+        }
         if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) {
             // Transmitted: update the stack of media.
             if (entering) {
@@ -382,7 +429,7 @@ void main() {
         aov.normal = float[3](n.x, n.y, n.z);
         vec3 ns;
         float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * 0.28867513;
-        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, sigma, ns).albedo);
+        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, coneFootprint(d, h.normal, sigma), ns).albedo);
         aov.albedo = float[3](alb.x, alb.y, alb.z);
         aovs[idx] = aov;
     }

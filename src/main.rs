@@ -56,8 +56,9 @@ struct RenderArgs {
     #[arg(long)]
     progress: bool,
     /// Texture filtering: `none` (bilinear lookups of the finest mip level; with
-    /// many samples per pixel, the reference) or `ray-cones` (EWA lookups over
-    /// ray-cone footprints, Akenine-Möller et al. 2021).
+    /// many samples per pixel, the reference), `ray-cones` (EWA lookups over
+    /// ray-cone footprints, Akenine-Möller et al. 2021) or `covariance` (EWA
+    /// lookups over covariance footprints carried along the path).
     #[arg(long, value_enum, default_value_t = Filter::None)]
     filter: Filter,
     /// Benchmark mode: after an untimed warm-up (lavapipe compiles shaders at
@@ -77,6 +78,8 @@ enum Filter {
     None,
     /// Ray cones with EWA lookups.
     RayCones,
+    /// Covariance footprints with EWA lookups.
+    Covariance,
 }
 
 impl Filter {
@@ -84,6 +87,7 @@ impl Filter {
         match self {
             Self::None => quadray::shader_interface::FILTER_NONE,
             Self::RayCones => quadray::shader_interface::FILTER_RAY_CONES,
+            Self::Covariance => quadray::shader_interface::FILTER_COVARIANCE,
         }
     }
 }

@@ -82,3 +82,6 @@ pub const SHADING_NONE: u32 = 1;
 pub const FILTER_NONE: u32 = 0;
 /// Texture filtering: ray cones (Akenine-Möller et al. 2021) with EWA lookups.
 pub const FILTER_RAY_CONES: u32 = 1;
+/// Texture filtering: covariance footprints carried along the path (the
+/// paper's method), with EWA lookups.
+pub const FILTER_COVARIANCE: u32 = 2;

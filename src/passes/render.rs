@@ -46,7 +46,7 @@ pub struct RenderVariant {
     /// `SHADING_FULL` or `SHADING_NONE` (the first hit's albedo: no light
     /// sampling, no shadow rays, no bounces).
     pub shading: u32,
-    /// Texture filtering: `FILTER_NONE` or `FILTER_RAY_CONES`.
+    /// Texture filtering: `FILTER_NONE`, `FILTER_RAY_CONES` or `FILTER_COVARIANCE`.
     pub filter: u32,
 }
 

@@ -1,0 +1,109 @@
+// Covariance footprints along light paths (after Belcour et al., "5D
+// Covariance Tracing for Efficient Defocus and Motion Blur", TOG 2013, and
+// "Antialiasing Complex Global Illumination Effects in Path-space", TOG
+// 2017), kept in the primal domain: P is the 4x4 covariance of the ray
+// bundle's offsets (x, y, θ, φ) in a frame (e1, e2) across the ray. Linear
+// operators A act as P' = A P Aᵀ, and a BSDF lobe of angular standard
+// deviation σ adds σ² to the angular variances (the spectral form of
+// src/covariance.rs: Σ⁻¹ = 4π² P). First order: surface curvature is not
+// applied yet, and angles are carried through frame changes unrotated.
+#ifndef COVARIANCE_GLSL
+#define COVARIANCE_GLSL
+
+struct PathCovariance {
+    mat4 p;    // primal covariance of (x, y, θ, φ); columns, GLSL convention
+    vec3 e1;   // frame across the ray
+    vec3 e2;
+};
+
+// Largest variance kept (keeps the matrix finite; about a 1e6 std).
+const float COV_MAX = 1e12;
+
+mat4 covClamp(mat4 m) {
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) {
+            float v = m[c][r];
+            m[c][r] = (isnan(v) || isinf(v)) ? 0.0 : clamp(v, -COV_MAX, COV_MAX);
+        }
+    return m;
+}
+
+// At the camera: a pixel's box filter of angular width `pixelAngle`
+// (variance w²/12), no spatial extent (a pinhole).
+PathCovariance covCamera(vec3 d, vec3 up, float pixelAngle) {
+    PathCovariance c;
+    c.e1 = normalize(cross(d, up));
+    c.e2 = cross(c.e1, d);
+    float v = pixelAngle * pixelAngle / 12.0;
+    c.p = mat4(0.0);
+    c.p[2][2] = v;
+    c.p[3][3] = v;
+    return c;
+}
+
+// Free travel over distance t: x += t θ, y += t φ.
+void covTravel(inout PathCovariance c, float t) {
+    mat4 a = mat4(1.0);
+    a[2][0] = t;  // column θ, row x
+    a[3][1] = t;
+    c.p = covClamp(a * c.p * transpose(a));
+}
+
+// Re-expresses the spatial and angular offsets in a new frame (e1n, e2n)
+// across the same ray.
+void covRotate(inout PathCovariance c, vec3 e1n, vec3 e2n) {
+    mat2 m = mat2(dot(c.e1, e1n), dot(c.e1, e2n), dot(c.e2, e1n), dot(c.e2, e2n));
+    mat4 a = mat4(0.0);
+    a[0][0] = m[0][0]; a[0][1] = m[0][1]; a[1][0] = m[1][0]; a[1][1] = m[1][1];
+    a[2][2] = m[0][0]; a[2][3] = m[0][1]; a[3][2] = m[1][0]; a[3][3] = m[1][1];
+    c.p = covClamp(a * c.p * transpose(a));
+    c.e1 = e1n;
+    c.e2 = e2n;
+}
+
+// Meets a surface of normal n: turns the path's frame so that e1 is the
+// component of t1 (the ray's direction projected on the surface) across the
+// ray and e2 = t2 = n × t1, and returns the spatial covariance on the
+// surface in the tangent basis (t1, t2): an offset x along e1 covers
+// x / |cos θ| along t1 (bounded at 20x). `inv` returns that 1 / |cos θ|.
+mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, out vec3 t1, out vec3 t2, out float inv) {
+    vec3 along = d - n * dot(n, d);
+    float al = length(along);
+    t1 = al > 1e-6 ? along / al : frameAround(n)[0];
+    t2 = cross(n, t1);
+    vec3 e1n = t1 - d * dot(d, t1);
+    float el = length(e1n);
+    e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, d));
+    covRotate(c, e1n, t2);
+    inv = 1.0 / max(abs(dot(d, n)), 0.05);
+    return mat2(c.p[0][0] * inv * inv, c.p[0][1] * inv, c.p[1][0] * inv, c.p[1][1]);
+}
+
+// Leaves the surface along wi. With the frames chosen as in covOnSurface
+// (e1 from t1, e2 from t2, on both sides) a flat mirror is the identity (the
+// unfolded path); the spatial offsets are the surface offsets seen across
+// the outgoing ray; a refraction scales the angles by (η cos θi / cos θt, η)
+// (first order); the lobe's angular standard deviation σ widens the angles.
+void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, float angleScaleX, float angleScaleY,
+               float lobeSigma) {
+    vec3 e1n = t1 - wi * dot(wi, t1);
+    float el = length(e1n);
+    e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, wi));
+    vec3 e2n = t2 - wi * dot(wi, t2);
+    float e2l = length(e2n);
+    e2n = e2l > 1e-6 ? e2n / e2l : normalize(cross(wi, e1n));
+    // Incoming (x, y) -> surface (x / |cos θ|, y) -> outgoing across wi.
+    mat2 m = mat2(dot(t1, e1n), dot(t1, e2n), dot(t2, e1n), dot(t2, e2n)) * mat2(inv, 0.0, 0.0, 1.0);
+    mat4 a = mat4(0.0);
+    a[0][0] = m[0][0]; a[0][1] = m[0][1]; a[1][0] = m[1][0]; a[1][1] = m[1][1];
+    a[2][2] = angleScaleX;
+    a[3][3] = angleScaleY;
+    mat4 p = a * c.p * transpose(a);
+    p[2][2] += lobeSigma * lobeSigma;
+    p[3][3] += lobeSigma * lobeSigma;
+    c.p = covClamp(p);
+    c.e1 = e1n;
+    c.e2 = e2n;
+}
+
+#endif
