@@ -10,6 +10,7 @@
 
 pub mod covariance;
 pub mod geometry;
+pub mod hash;
 pub mod output;
 pub mod passes;
 pub mod sampling;

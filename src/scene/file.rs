@@ -29,6 +29,8 @@ use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::hash::hash_unit;
+
 use super::{
     Camera, ConductorFresnel, EnvironmentMapSettings, ImageSettings, Light, Material, MaterialKind, MaterialMaps,
     Scene, SceneObject, TextureImage, UvMapping, UvSettings,
@@ -2028,18 +2030,6 @@ fn scatter(p: ScatterParams) -> impl Iterator<Item = Perturbation> {
         let f = if p.alternate && i % 2 == 1 { -p.form_factor } else { p.form_factor };
         Perturbation { quadric: Quadric::ellipsoid(p.centre + p.on_radii * u, p.radius), form_factor: f }
     })
-}
-
-/// A deterministic number in [0, 1) from a seed, an index and a stream
-/// (SplitMix64 finalizer).
-fn hash_unit(seed: u32, index: u64, stream: u64) -> f64 {
-    let mut z = (u64::from(seed) << 32 ^ index)
-        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(stream.wrapping_mul(0xD1B5_4A32_D192_ED03));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
 #[cfg(test)]

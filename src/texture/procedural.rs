@@ -107,15 +107,9 @@ pub fn normals_from_heights(heights: &TextureImage, strength: f32) -> TextureIma
 }
 
 /// A deterministic number in [0, 1) from a seed, an index and a stream: a
-/// SplitMix64-style finaliser of the three packed into 64 bits.
+/// A number in [0, 1) from (seed, index, stream); see [`crate::hash::hash_unit`].
 fn hash_unit(seed: u32, index: u32, stream: u32) -> f64 {
-    let mut z = (u64::from(seed) << 32 | u64::from(index))
-        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(u64::from(stream).wrapping_add(1).wrapping_mul(0xD1B5_4A32_D192_ED03));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
-    (z >> 11) as f64 / (1u64 << 53) as f64
+    crate::hash::hash_unit(seed, u64::from(index), u64::from(stream) + 1)
 }
 
 #[cfg(test)]
