@@ -51,12 +51,7 @@ float envMapPdf(vec3 d, uint w, uint h) {
 }
 
 LightSample sampleEnvMap(vec2 u, uint w, uint h) {
-    LightSample s;
-    s.valid = false;
-    s.dist = 1e30;
-    s.pdf = 0.0;
-    s.radiance = vec3(0.0);
-    s.wi = vec3(0.0, 1.0, 0.0);
+    LightSample s = noLightSample();
     uint j = searchCdf(0u, h, u.x);
     float pRow = envCdfAt(j + 1u) - envCdfAt(j);
     uint row = h + 1u + j * (w + 1u);

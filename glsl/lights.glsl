@@ -28,6 +28,17 @@ struct LightSample {
     bool valid;
 };
 
+// An invalid sample, to be filled in.
+LightSample noLightSample() {
+    LightSample s;
+    s.valid = false;
+    s.pdf = 0.0;
+    s.dist = 1e30;
+    s.radiance = vec3(0.0);
+    s.wi = vec3(0.0, 0.0, 1.0);
+    return s;
+}
+
 float powerHeuristic(float a, float b) {
     float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0.0 ? a2 / (a2 + b2) : 0.0;
@@ -75,12 +86,7 @@ LightSample sampleEnvironment(vec3 background, vec2 u) {
 
 // Samples a direction toward light l from x.
 LightSample sampleLight(Light l, vec3 x, vec2 u) {
-    LightSample s;
-    s.valid = false;
-    s.pdf = 0.0;
-    s.dist = 1e30;
-    s.radiance = vec3(0.0);
-    s.wi = vec3(0.0, 0.0, 1.0);
+    LightSample s = noLightSample();
     vec3 p = v3(l.position);
     if (l.kind == LIGHT_POINT) {
         vec3 toL = p - x;
