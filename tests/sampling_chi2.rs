@@ -29,9 +29,7 @@ fn level() -> f64 {
 }
 
 fn check(name: &str, report: &Chi2Report) {
-    println!("{name:<44} {report}");
-    let why = report.failures(level());
-    assert!(why.is_empty(), "{name}: {report}\n  fails: {}", why.join("; "));
+    report.assert_passes(name, level());
 }
 
 /// A unit direction at polar angle `theta` (from +z) and azimuth `phi`.

@@ -150,6 +150,14 @@ impl Chi2Report {
     pub fn passed(&self, level: f64) -> bool {
         self.failures(level).is_empty()
     }
+
+    /// Prints the report under `name` and panics with the reasons when the
+    /// test fails at significance `level` (for test suites).
+    pub fn assert_passes(&self, name: &str, level: f64) {
+        println!("{name:<52} {self}");
+        let why = self.failures(level);
+        assert!(why.is_empty(), "{name}: {self}\n  fails: {}", why.join("; "));
+    }
 }
 
 impl fmt::Display for Chi2Report {
