@@ -25,18 +25,9 @@ struct Material {
     uint roughnessMap;
     uint displacementMap;
     float displacementScale;  // object units per unit of displacement
+    uint normalMoments;       // slope moments of the normal map (texture/lean.rs), or NO_TEXTURE
+    uint displacementMoments; // slope moments of the displacement map, or NO_TEXTURE
 };
-
-// An orthonormal basis around n (Duff et al., "Building an Orthonormal Basis,
-// Revisited", JCGT 2017).
-mat3 frameAround(vec3 n) {
-    float s = n.z >= 0.0 ? 1.0 : -1.0;
-    float a = -1.0 / (s + n.z);
-    float b = n.x * n.y * a;
-    vec3 t = vec3(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
-    vec3 bt = vec3(b, s + n.y * n.y * a, -n.y);
-    return mat3(t, bt, n);  // columns: local x, y, z
-}
 
 vec3 sampleCosineHemisphere(vec2 u) {
     float r = sqrt(u.x), phi = 2.0 * PI * u.y;

@@ -5,8 +5,15 @@
 // bundle's offsets (x, y, θ, φ) in a frame (e1, e2) across the ray. Linear
 // operators A act as P' = A P Aᵀ, and a BSDF lobe of angular standard
 // deviation σ adds σ² to the angular variances (the spectral form of
-// src/covariance.rs: Σ⁻¹ = 4π² P). First order: surface curvature is not
-// applied yet, and angles are carried through frame changes unrotated.
+// src/covariance.rs: Σ⁻¹ = 4π² P). First order throughout; the surface's
+// exact curvature (shape operator from the analytic Hessian of F') shears
+// the outgoing angles by the tilt of the normal across the footprint.
+//
+// Clamps (each keeps the matrix finite; none is active on ordinary paths):
+// - every entry is clamped to ±COV_MAX (1e12) after each operator, NaN -> 0;
+// - 1 / |cos θ| on a surface is bounded by 20 (grazing hits: the footprint's
+//   stretch along the surface is at most 20x), and cos θt in a refraction's
+//   angle scale by 0.05 likewise.
 #ifndef COVARIANCE_GLSL
 #define COVARIANCE_GLSL
 
@@ -84,7 +91,16 @@ mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, out vec3 t1, out vec3 
 // unfolded path); the spatial offsets are the surface offsets seen across
 // the outgoing ray; a refraction scales the angles by (η cos θi / cos θt, η)
 // (first order); the lobe's angular standard deviation σ widens the angles.
-void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, float angleScaleX, float angleScaleY,
+//
+// Curvature (Belcour et al. 2013, sec. 4, "curvature", here in primal form):
+// at surface offset u = (x / |cos θ|, y) the normal facing the incoming ray
+// tilts by S u (S: shape operator of that normal in (t1, t2)), which turns
+// the outgoing direction by g ⊙ (S u). The gains g, from differentiating the
+// reflection and refraction laws (in the plane of incidence, then across it):
+// mirror reflection (2, 2 cos θi); refraction (η cos θi / cos θt − 1,
+// η cos θi − cos θt); a diffuse lobe turns with the normal (1, 1). The
+// operator is the shear θ' = s ⊙ θ + g ⊙ (S u).
+void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, vec2 angleScale, mat2 shape, vec2 gain,
                float lobeSigma) {
     vec3 e1n = t1 - wi * dot(wi, t1);
     float el = length(e1n);
@@ -93,11 +109,14 @@ void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, flo
     float e2l = length(e2n);
     e2n = e2l > 1e-6 ? e2n / e2l : normalize(cross(wi, e1n));
     // Incoming (x, y) -> surface (x / |cos θ|, y) -> outgoing across wi.
-    mat2 m = mat2(dot(t1, e1n), dot(t1, e2n), dot(t2, e1n), dot(t2, e2n)) * mat2(inv, 0.0, 0.0, 1.0);
+    mat2 toSurface = mat2(inv, 0.0, 0.0, 1.0);
+    mat2 m = mat2(dot(t1, e1n), dot(t1, e2n), dot(t2, e1n), dot(t2, e2n)) * toSurface;
+    mat2 shear = mat2(gain.x, 0.0, 0.0, gain.y) * shape * toSurface;
     mat4 a = mat4(0.0);
     a[0][0] = m[0][0]; a[0][1] = m[0][1]; a[1][0] = m[1][0]; a[1][1] = m[1][1];
-    a[2][2] = angleScaleX;
-    a[3][3] = angleScaleY;
+    a[0][2] = shear[0][0]; a[0][3] = shear[0][1]; a[1][2] = shear[1][0]; a[1][3] = shear[1][1];
+    a[2][2] = angleScale.x;
+    a[3][3] = angleScale.y;
     mat4 p = a * c.p * transpose(a);
     p[2][2] += lobeSigma * lobeSigma;
     p[3][3] += lobeSigma * lobeSigma;

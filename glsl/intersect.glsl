@@ -209,9 +209,34 @@ vec3 cellGradient(uint object, uint cellIndex, vec3 p) {
     return g;
 }
 
+// Hessian of F' at p (object frame): H_F + Σ 3 f q (2 ∇q ∇qᵀ + q H_q) over
+// the cell's perturbations with q > 0. Twin: FunctionalObject::hessian.
+mat3 quadricHessian(Quadric q) {
+    return 2.0 * mat3(q.a[0], q.a[3], q.a[5], q.a[3], q.a[1], q.a[4], q.a[5], q.a[4], q.a[2]);
+}
+
+mat3 cellHessian(uint object, uint cellIndex, vec3 p) {
+    Cell cell = cells[cellIndex];
+    mat3 hess = quadricHessian(objects[object].base);
+    for (uint i = 0; i < cell.count; ++i) {
+        uint k = cellLists[cell.first + i];
+        vec3 h = p - v3(perturbations[k].centre);
+        float radius = perturbations[k].radius;
+        if (radius >= 0.0 && dot(h, h) > radius * radius) continue;
+        Quadric pq = perturbations[k].q;
+        float q = quadricAt(pq, h);
+        if (q > 0.0) {
+            vec3 g = quadricGradient(pq, h);
+            hess += (3.0 * perturbations[k].f * q) * (2.0 * outerProduct(g, g) + q * quadricHessian(pq));
+        }
+    }
+    return hess;
+}
+
 struct SceneHit {
     float t;             // NO_ROOT on a miss
     uint object;
+    uint cell;           // index into cells[] of the hit's cell
     vec3 normal;         // world space, outward (-∇F'), unit length
     vec3 objectPoint;    // the hit in the object's frame
     mat3 worldToObject;  // linear part of the world-to-object transform
@@ -247,6 +272,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
     SceneHit h;
     h.t = NO_ROOT;
     h.object = NO_HIT;
+    h.cell = 0u;
     h.normal = vec3(0.0);
     h.objectPoint = vec3(0.0);
     h.worldToObject = mat3(1.0);
@@ -254,6 +280,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
         h.t = rayQueryGetIntersectionTEXT(rq, true);
         h.object = candidateObject(rq, true);
         uint cell = candidateCell(rq, h.object, true);
+        h.cell = cell;
         vec3 oo = rayQueryGetIntersectionObjectRayOriginEXT(rq, true);
         vec3 od = rayQueryGetIntersectionObjectRayDirectionEXT(rq, true);
         h.objectPoint = oo + h.t * od;
@@ -264,6 +291,21 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
         h.normal = len > 0.0 ? n / len : -d;
     }
     return h;
+}
+
+// The shape operator of the surface at a hit (the derivative of the outward
+// unit normal along the surface, positive on a convex bump) in the tangent
+// basis (t1, t2), world units: S_ij = -t_iᵀ Mᵀ H M t_j / |Mᵀ ∇F'| with M the
+// world-to-object map (F'(M p + c) in world space). Exact: the analytic
+// Hessian of F'. Twin: FunctionalObject::curvatures.
+mat2 shapeOperator(SceneHit h, vec3 t1, vec3 t2) {
+    vec3 g = transpose(h.worldToObject) * cellGradient(h.object, h.cell, h.objectPoint);
+    float len = length(g);
+    if (len == 0.0) return mat2(0.0);
+    mat3 hess = cellHessian(h.object, h.cell, h.objectPoint);
+    vec3 a = h.worldToObject * t1, b = h.worldToObject * t2;
+    float s11 = -dot(a, hess * a) / len, s12 = -dot(a, hess * b) / len, s22 = -dot(b, hess * b) / len;
+    return mat2(s11, s12, s12, s22);
 }
 
 // True when something blocks o + t d for t in [tmin, tmax].

@@ -16,7 +16,9 @@ struct Hit {
     float t;
     float normal[3];
     uint object;
-    uint pad[3];
+    float meanCurvature;   // of the outward normal (positive when convex)
+    float gaussCurvature;
+    uint pad;
 };
 
 layout(set = 0, binding = BINDING_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
@@ -38,6 +40,14 @@ void main() {
     outHit.t = h.t;
     outHit.normal = float[3](h.normal.x, h.normal.y, h.normal.z);
     outHit.object = h.object;
-    outHit.pad = uint[3](0u, 0u, 0u);
+    outHit.meanCurvature = 0.0;
+    outHit.gaussCurvature = 0.0;
+    if (h.object != NO_HIT) {
+        mat3 f = frameAround(h.normal);
+        mat2 s = shapeOperator(h, f[0], f[1]);
+        outHit.meanCurvature = 0.5 * (s[0][0] + s[1][1]);
+        outHit.gaussCurvature = determinant(s);
+    }
+    outHit.pad = 0u;
     hits[i] = outHit;
 }

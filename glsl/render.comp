@@ -145,15 +145,37 @@ Material surfaceAt(SceneHit h, vec3 d, mat2 footprint, out vec3 shadingNormal) {
     if (mat.normalMap == NO_TEXTURE && mat.displacementMap == NO_TEXTURE) return mat;
     vec3 dpdu, dpdv;
     tangentsFromGradients(gu, gv, n, dpdu, dpdv);
+    // Filtered modes read the maps' slope moments over the footprint (LEAN):
+    // the mean slope bends the normal, the variance widens the lobe.
+    bool lean = FILTER_MODE != FILTER_NONE;
+    float slopeVar = 0.0;
     if (mat.displacementMap != NO_TEXTURE) {
         // Bump mapping: the normal of p + scale · height(u, v) · n.
-        vec3 hs = heightAndSlopes(mat.displacementMap, s.uv) * mat.displacementScale;
-        vec3 bent = cross(dpdu + hs.y * n, dpdv + hs.z * n);
+        vec2 slopes;
+        if (lean) {
+            vec4 m = lookup(mat.displacementMoments, fp);
+            slopes = m.xy * mat.displacementScale;
+            // World slopes are uv slopes over |∂p/∂u|, |∂p/∂v|.
+            float su = dot(dpdu, dpdu), sv = dot(dpdv, dpdv);
+            float vu = su > 0.0 ? max(m.z - m.x * m.x, 0.0) / su : 0.0;
+            float vv = sv > 0.0 ? max(m.w - m.y * m.y, 0.0) / sv : 0.0;
+            slopeVar += 0.5 * (vu + vv) * mat.displacementScale * mat.displacementScale;
+        } else {
+            slopes = heightAndSlopes(mat.displacementMap, s.uv).yz * mat.displacementScale;
+        }
+        vec3 bent = cross(dpdu + slopes.x * n, dpdv + slopes.y * n);
         float len = length(bent);
         if (len > 0.0) n = dot(bent, n) >= 0.0 ? bent / len : -bent / len;
     }
     if (mat.normalMap != NO_TEXTURE) {
-        vec3 c = lookup(mat.normalMap, fp).rgb * 2.0 - 1.0;
+        vec3 c;
+        if (lean) {
+            vec4 m = lookup(mat.normalMoments, fp);
+            c = normalize(vec3(-m.x, -m.y, 1.0));
+            slopeVar += slopeVariance(m);
+        } else {
+            c = mapAt(mat.normalMap, fp.uv).rgb * 2.0 - 1.0;
+        }
         vec3 t = dpdu - n * dot(n, dpdu);
         float tl = length(t);
         mat3 f = frameAround(n);
@@ -163,6 +185,11 @@ Material surfaceAt(SceneHit h, vec3 d, mat2 footprint, out vec3 shadingNormal) {
         vec3 m = c.x * t + c.y * b + c.z * n;
         float ml = length(m);
         if (ml > 0.0) n = m / ml;
+    }
+    // The normals that filtering averaged away widen a glossy lobe (Lambert
+    // is unchanged; a perfect mirror stays a delta lobe).
+    if (slopeVar > 0.0 && (mat.kind == MATERIAL_CONDUCTOR || mat.kind == MATERIAL_DIELECTRIC)) {
+        mat.roughness = sqrt(min(widenedAlpha(materialAlpha(mat), slopeVar), 1.0));
     }
     shadingNormal = n;
     return mat;
@@ -370,17 +397,22 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         if (FILTER_MODE == FILTER_COVARIANCE) {
             vec3 wiWorld = normalize(frameW * bs.wi);
             bool transmitted = bs.wi.z * wo.z < 0.0;
-            float sx = 1.0, sy = 1.0;
+            float cosI = abs(wo.z), cosT = max(abs(bs.wi.z), 0.05);
+            vec2 scale = vec2(1.0), gain = vec2(2.0, 2.0 * cosI);
             if (transmitted) {
                 // Angles scale by η cos θi / cos θt and η, with η = n_i / n_t.
                 float eta = wo.z > 0.0 ? 1.0 / mat.ior : mat.ior;
-                sx = eta * abs(wo.z) / max(abs(bs.wi.z), 0.05);
-                sy = eta;
+                scale = vec2(eta * cosI / cosT, eta);
+                gain = vec2(eta * cosI / cosT - 1.0, eta * cosI - cosT);
+            } else if (mat.kind == MATERIAL_DIFFUSE) {
+                gain = vec2(1.0);
             }
+            // The shape operator of the normal facing the incoming ray.
+            mat2 shape = shapeOperator(h, ct1, ct2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
             // Angular standard deviation of the lobe: about √2 α for GGX
             // reflection, about 0.6 rad for Lambert, 0 for delta lobes.
             float lobe = isDelta(mat) ? 0.0 : (mat.kind == MATERIAL_DIFFUSE ? 0.6 : 1.41421356 * materialAlpha(mat));
-            covBounce(cov, covInv, ct1, ct2, wiWorld, sx, sy, lobe);
+            covBounce(cov, covInv, ct1, ct2, wiWorld, scale, shape, gain, lobe);
         }
         if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) {
             // Transmitted: update the stack of media.

@@ -40,10 +40,13 @@ vec4 ewaLookup(uint index, Footprint fp) {
     // Bound the anisotropy by widening the minor axis.
     l2 = max(l2, l1 / (MAX_ANISOTROPY * MAX_ANISOTROPY));
     float sigmaMinor = sqrt(l2), sigmaMajor = sqrt(l1);
-    // The level where the minor axis spans about one texel, raised until the
-    // 2σ ellipse holds at most MAX_TAPS texels.
-    float level = max(0.0, floor(log2(max(sigmaMinor, 1e-8))));
-    while (level < float(levels - 1) && 12.6 * sigmaMajor * sigmaMinor / exp2(2.0 * level) > MAX_TAPS) level += 1.0;
+    // The level where the minor axis spans about two texels (one more would
+    // add the level's own blur, a box of 2^level texels and the σ = ½ texel
+    // reconstruction, in a proportion that visibly over-blurs), raised until
+    // the 3σ ellipse holds at most MAX_TAPS texels; at most the last level.
+    float last = float(levels - 1);
+    float level = clamp(floor(log2(max(sigmaMinor, 1e-8))) - 1.0, 0.0, last);
+    while (level < last && 28.3 * sigmaMajor * sigmaMinor / exp2(2.0 * level) > MAX_TAPS) level += 1.0;
     int li = int(level);
     ivec2 size = max(size0 >> li, ivec2(1));
     if (size == ivec2(1)) return texelFetch(textures[nonuniformEXT(index)], ivec2(0), li);
@@ -52,7 +55,7 @@ vec4 ewaLookup(uint index, Footprint fp) {
     mat2 cl = (l1 * outerProduct(e1, e1) + l2 * outerProduct(e2, e2)) * (scale * scale) + mat2(0.25);
     mat2 inv = inverse(cl);
     vec2 centre = fp.uv * vec2(size) - 0.5;
-    vec2 radius = 2.0 * sqrt(vec2(cl[0][0], cl[1][1]));
+    vec2 radius = 3.0 * sqrt(vec2(cl[0][0], cl[1][1]));
     ivec2 lo = ivec2(floor(centre - radius)), hi = ivec2(ceil(centre + radius));
     vec4 sum = vec4(0.0);
     float weights = 0.0;
@@ -60,7 +63,7 @@ vec4 ewaLookup(uint index, Footprint fp) {
         for (int x = lo.x; x <= hi.x; ++x) {
             vec2 dxy = vec2(x, y) - centre;
             float q = dot(dxy, inv * dxy);
-            if (q > 4.0) continue;
+            if (q > 9.0) continue;  // the Gaussian beyond 3σ (1% of its mass) is dropped
             float w = exp(-0.5 * q);
             sum += w * texelWrapped(index, ivec2(x, y), li, size);
             weights += w;
@@ -68,5 +71,18 @@ vec4 ewaLookup(uint index, Footprint fp) {
     }
     return weights > 0.0 ? sum / weights : texelWrapped(index, ivec2(floor(centre + 0.5)), li, size);
 }
+
+// LEAN filtering of normal and displacement maps (M. Olano, D. Baker, "LEAN
+// Mapping", I3D 2010): a slope-moment texel (E[sx], E[sy], E[sx²], E[sy²])
+// filtered over a footprint gives the mean slope (the filtered normal) and
+// the per-axis slope variance of the normals filtering averaged away. Twin:
+// src/texture/lean.rs.
+float slopeVariance(vec4 m) { return max(0.5 * (m.z - m.x * m.x + m.w - m.y * m.y), 0.0); }
+
+// GGX α widened by a per-axis slope variance: √(α² + 2σ²) (a Beckmann lobe
+// of roughness α has slope variance α²/2 per axis; variances add).
+float widenedAlpha(float alpha, float variance) { return sqrt(alpha * alpha + 2.0 * max(variance, 0.0)); }
+
+float leanAlpha(float alpha, vec4 moments) { return widenedAlpha(alpha, slopeVariance(moments)); }
 
 #endif

@@ -13,6 +13,7 @@ pub mod geometry;
 pub mod hash;
 pub mod output;
 pub mod passes;
+pub mod plot;
 pub mod sampling;
 pub mod scene;
 pub mod shader_interface;

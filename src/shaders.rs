@@ -21,3 +21,8 @@ pub fn twins() -> Vec<u32> {
 pub fn probe() -> Vec<u32> {
     words(include_bytes!(concat!(env!("OUT_DIR"), "/probe.comp.spv")))
 }
+
+/// `glsl/texprobe.comp`: filtered texture lookups on given footprints.
+pub fn texprobe() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/texprobe.comp.spv")))
+}

@@ -9,7 +9,9 @@
 //!   `CLIP_EDGE` (relative to the object's size) from its clip box's boundary;
 //! - on agreeing hits, depth error |Δt| / max(t, |origin|) <= `MAX_DEPTH_ERROR`
 //!   (f32 positions carry errors relative to their magnitude) and normal
-//!   angle error <= `MAX_NORMAL_DEGREES` (`FAR_*` for rays from 1e3..1e4 away).
+//!   angle error <= `MAX_NORMAL_DEGREES`, principal curvatures (from the
+//!   analytic Hessian) within `MAX_CURVATURE_ERROR` (`FAR_*` for rays from
+//!   1e3..1e4 away).
 
 mod common;
 
@@ -36,6 +38,12 @@ const FAR_MAX_DEPTH_ERROR: f64 = 1e-5;
 /// radius ~0.02) that turns the normal by up to ~0.06 rad. Re-basing the ray
 /// origin in f64 would remove this (the stress-suite issue).
 const FAR_MAX_NORMAL_DEGREES: f64 = 5.0;
+/// Principal curvatures from the analytic Hessian of F' (f32 on the GPU),
+/// relative to the largest principal curvature plus 1 / object size.
+const MAX_CURVATURE_ERROR: f64 = 1e-2;
+/// Far rays: the hit point is off by ~1e-3 (see above), which on the
+/// sharpest bumps changes the curvature itself by tens of percent.
+const FAR_MAX_CURVATURE_ERROR: f64 = 1.0;
 /// Rays that start on a surface skip this much (the renderer offsets its
 /// secondary rays similarly).
 const ON_SURFACE_TMIN: f64 = 1e-3;
@@ -54,6 +62,8 @@ struct RefHit {
     normal: DVec3,
     /// |cos| between the ray and the normal.
     cos: f64,
+    /// World-space mean and Gaussian curvature of the outward normal.
+    curvatures: (f64, f64),
     /// Distance to the object's clip-box boundary relative to its size.
     clip_edge: f64,
 }
@@ -82,10 +92,39 @@ fn trace_reference(scene: &[Placed], o: DVec3, d: DVec3, tmin: f64) -> Option<Re
         if let Some(h) = reference::intersect_within(&p.obj.shape, &p.bounds, ol, dl, tmin, tmax) {
             let normal = (p.inverse.matrix3.transpose() * h.normal).normalize();
             let clip_edge = p.obj.shape.clip.map_or(f64::INFINITY, |c| c.distance_to_boundary(ol + h.t * dl) / p.size);
-            best = Some(RefHit { t: h.t, object: i, normal, cos: normal.dot(d).abs(), clip_edge });
+            let curvatures = world_curvatures(p, ol + h.t * dl);
+            best = Some(RefHit { t: h.t, object: i, normal, cos: normal.dot(d).abs(), curvatures, clip_edge });
         }
     }
     best
+}
+
+/// Mean and Gaussian curvature in world space at the object-frame point `p`:
+/// with M the world-to-object map, ∇ = Mᵀ g and H = Mᵀ H_F' M (f64).
+fn world_curvatures(p: &Placed, local: DVec3) -> (f64, f64) {
+    let m = p.inverse.matrix3;
+    let g = m.transpose() * p.obj.shape.gradient(local);
+    let len = g.length();
+    let h = m.transpose() * p.obj.shape.hessian(local) * m;
+    let (t1, t2) = (g / len).any_orthonormal_pair();
+    let s = |a: DVec3, b: DVec3| -a.dot(h * b) / len;
+    let (s11, s12, s22) = (s(t1, t1), s(t1, t2), s(t2, t2));
+    (0.5 * (s11 + s22), s11 * s22 - s12 * s12)
+}
+
+/// Principal curvatures (k1 >= k2) from the mean and Gaussian curvature.
+fn principal(mean: f64, gauss: f64) -> (f64, f64) {
+    let r = (mean * mean - gauss).max(0.0).sqrt();
+    (mean + r, mean - r)
+}
+
+/// Error of the principal curvatures relative to the largest of them plus
+/// the object's 1 / size (so that near-flat points are judged on an absolute
+/// scale).
+fn curvature_error(g: &GpuHit, r: &RefHit, size: f64) -> f64 {
+    let (a1, a2) = principal(g.mean_curvature as f64, g.gauss_curvature as f64);
+    let (b1, b2) = principal(r.curvatures.0, r.curvatures.1);
+    ((a1 - b1).abs().max((a2 - b2).abs())) / (b1.abs().max(b2.abs()) + 1.0 / size)
 }
 
 fn gpu_cos(h: &GpuHit, d: DVec3) -> f64 {
@@ -101,6 +140,7 @@ struct Stats {
     failures: usize,
     max_depth_error: f64,
     max_normal_degrees: f64,
+    max_curvature_error: f64,
     first_failures: Vec<String>,
 }
 
@@ -137,6 +177,11 @@ fn compare(
                 let angle = n.dot(r.normal).clamp(-1.0, 1.0).acos().to_degrees();
                 stats.max_depth_error = stats.max_depth_error.max(depth);
                 stats.max_normal_degrees = stats.max_normal_degrees.max(angle);
+                stats.max_curvature_error = stats.max_curvature_error.max(curvature_error(
+                    g,
+                    r,
+                    world_bounds(&scene[r.object]).size().length(),
+                ));
             }
             _ => {
                 if near_edge_gpu || near_edge_ref {
@@ -264,14 +309,14 @@ fn gpu_hits_match_the_f64_reference() {
 
     let mut all_ok = true;
     println!(
-        "{:<11} {:>7} {:>7} {:>8} {:>8} {:>9} {:>12} {:>12}",
-        "category", "rays", "hits", "agree", "excused", "failures", "max depth", "max normal°"
+        "{:<11} {:>7} {:>7} {:>8} {:>8} {:>9} {:>12} {:>12} {:>10}",
+        "category", "rays", "hits", "agree", "excused", "failures", "max depth", "max normal°", "max curv"
     );
-    for (name, rays, depth_bound, normal_bound) in [
-        ("random", &random, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES),
-        ("far", &far, FAR_MAX_DEPTH_ERROR, FAR_MAX_NORMAL_DEGREES),
-        ("on-surface", &on_surface, ON_SURFACE_MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES),
-        ("grazing", &grazing, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES),
+    for (name, rays, depth_bound, normal_bound, curvature_bound) in [
+        ("random", &random, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES, MAX_CURVATURE_ERROR),
+        ("far", &far, FAR_MAX_DEPTH_ERROR, FAR_MAX_NORMAL_DEGREES, FAR_MAX_CURVATURE_ERROR),
+        ("on-surface", &on_surface, ON_SURFACE_MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES, MAX_CURVATURE_ERROR),
+        ("grazing", &grazing, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES, MAX_CURVATURE_ERROR),
     ] {
         let probe = ProbePass::new(&ctx.device, &gpu_scene, rays, INTERSECT_FULL).unwrap();
         let (hits, _) = probe.run(&mut cmds).unwrap();
@@ -286,20 +331,33 @@ fn gpu_hits_match_the_f64_reference() {
         let mut s = Stats::default();
         compare(&placed, rays, &hits, &refs, &mut s, clip_distance);
         println!(
-            "{:<11} {:>7} {:>7} {:>8} {:>8} {:>9} {:>12.3e} {:>12.4}",
-            name, s.rays, s.hits, s.agree, s.excused, s.failures, s.max_depth_error, s.max_normal_degrees
+            "{:<11} {:>7} {:>7} {:>8} {:>8} {:>9} {:>12.3e} {:>12.4} {:>10.3e}",
+            name,
+            s.rays,
+            s.hits,
+            s.agree,
+            s.excused,
+            s.failures,
+            s.max_depth_error,
+            s.max_normal_degrees,
+            s.max_curvature_error
         );
         for f in &s.first_failures {
             println!("  {f}");
         }
-        let ok = s.failures == 0 && s.max_depth_error <= depth_bound && s.max_normal_degrees <= normal_bound;
+        let ok = s.failures == 0
+            && s.max_depth_error <= depth_bound
+            && s.max_normal_degrees <= normal_bound
+            && s.max_curvature_error <= curvature_bound;
         if !ok {
-            println!("  -> {name}: bounds are depth <= {depth_bound:e}, normal <= {normal_bound}°, no unexcused disagreement");
+            println!(
+                "  -> {name}: bounds are depth <= {depth_bound:e}, normal <= {normal_bound}°, curvature <= {curvature_bound:e}, no unexcused disagreement"
+            );
         }
         all_ok &= ok;
     }
     println!(
-        "bounds: silhouette {SILHOUETTE_DEGREES}°, clip edge {CLIP_EDGE} x object size, depth {MAX_DEPTH_ERROR:e} (on-surface {ON_SURFACE_MAX_DEPTH_ERROR:e}, far {FAR_MAX_DEPTH_ERROR:e}), normal {MAX_NORMAL_DEGREES}° (far {FAR_MAX_NORMAL_DEGREES}°)"
+        "bounds: silhouette {SILHOUETTE_DEGREES}°, clip edge {CLIP_EDGE} x object size, depth {MAX_DEPTH_ERROR:e} (on-surface {ON_SURFACE_MAX_DEPTH_ERROR:e}, far {FAR_MAX_DEPTH_ERROR:e}), normal {MAX_NORMAL_DEGREES}° (far {FAR_MAX_NORMAL_DEGREES}°), principal curvatures {MAX_CURVATURE_ERROR:e} (far {FAR_MAX_CURVATURE_ERROR:e})"
     );
     drop(gpu_scene);
     drop(cmds);

@@ -2,7 +2,7 @@
 //! with its inside where F' >= 0, and an optional clip box that bounds
 //! unbounded surfaces.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use thiserror::Error;
 
 use super::{Aabb, Quadric};
@@ -99,6 +99,39 @@ impl FunctionalObject {
             }
         }
         g
+    }
+
+    /// Hessian of F' at `p`: H_F + Σ 3 f_i Q_i (2 ∇Q_i ∇Q_iᵀ + Q_i H_Qi) over
+    /// the perturbations with Q_i > 0 (the second derivative of f q³).
+    pub fn hessian(&self, p: DVec3) -> DMat3 {
+        let mut h = self.base.hessian();
+        for t in &self.perturbations {
+            let q = t.quadric.eval(p);
+            if q > 0.0 {
+                let g = t.quadric.gradient(p);
+                let outer = DMat3::from_cols(g * g.x, g * g.y, g * g.z);
+                h += (outer * 2.0 + t.quadric.hessian() * q) * (3.0 * t.form_factor * q);
+            }
+        }
+        h
+    }
+
+    /// Mean and Gaussian curvature of the surface F' = 0 at `p`, for the
+    /// outward normal n = -∇F'/|∇F'| (positive on a convex bump). The shape
+    /// operator is dn/dp on the tangent plane: S = -P H P / |∇F'| with P the
+    /// projection onto the tangent plane (a sphere of radius r has S = I/r).
+    pub fn curvatures(&self, p: DVec3) -> (f64, f64) {
+        let g = self.gradient(p);
+        let len = g.length();
+        if len == 0.0 {
+            return (0.0, 0.0);
+        }
+        let n = g / len;
+        let (t1, t2) = n.any_orthonormal_pair();
+        let h = self.hessian(p);
+        let s = |a: DVec3, b: DVec3| -a.dot(h * b) / len;
+        let (s11, s12, s22) = (s(t1, t1), s(t1, t2), s(t2, t2));
+        (0.5 * (s11 + s22), s11 * s22 - s12 * s12)
     }
 
     /// The outward unit normal at `p` (the inside is F' >= 0).
@@ -247,6 +280,56 @@ mod tests {
 
     fn sphere() -> FunctionalObject {
         FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None }
+    }
+
+    #[test]
+    fn hessian_matches_finite_differences_of_the_gradient() {
+        let mut o = sphere();
+        for (i, c) in
+            [DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 0.8, 0.6), DVec3::new(0.6, 0.0, 0.8)].iter().enumerate()
+        {
+            let q = Quadric::ellipsoid(*c, DVec3::new(0.5, 0.4, 0.3));
+            o.perturbations.push(Perturbation { quadric: q, form_factor: if i == 1 { -0.7 } else { 1.3 } });
+        }
+        let e = 1e-5;
+        let mut checked = 0;
+        for p in [DVec3::new(0.9, 0.1, 0.05), DVec3::new(0.1, 0.7, 0.5), DVec3::new(0.5, -0.05, 0.7)] {
+            assert!(o.perturbations.iter().any(|t| t.quadric.eval(p) > 0.0));
+            let h = o.hessian(p);
+            for (k, axis) in [DVec3::X, DVec3::Y, DVec3::Z].into_iter().enumerate() {
+                let column = (o.gradient(p + e * axis) - o.gradient(p - e * axis)) / (2.0 * e);
+                let err = (column - h.col(k)).abs().max_element();
+                assert!(err < 1e-6 * h.col(k).abs().max_element().max(1.0), "column {k} at {p}: {err}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 9);
+    }
+
+    #[test]
+    fn curvatures_of_a_sphere_and_an_ellipsoid_tip_are_the_closed_forms() {
+        let s = FunctionalObject {
+            base: Quadric::ellipsoid(DVec3::ZERO, DVec3::splat(2.0)),
+            perturbations: vec![],
+            clip: None,
+        };
+        let (mean, gauss) = s.curvatures(DVec3::new(0.0, 2.0, 0.0));
+        assert!((mean - 0.5).abs() < 1e-12 && (gauss - 0.25).abs() < 1e-12, "{mean} {gauss}");
+        // Ellipsoid of radii (a, b, c) at (a, 0, 0): principal curvatures a / b², a / c².
+        let (a, b, c) = (3.0, 2.0, 0.5);
+        let e = FunctionalObject {
+            base: Quadric::ellipsoid(DVec3::ZERO, DVec3::new(a, b, c)),
+            perturbations: vec![],
+            clip: None,
+        };
+        let (mean, gauss) = e.curvatures(DVec3::new(a, 0.0, 0.0));
+        let (k1, k2) = (a / (b * b), a / (c * c));
+        assert!((mean - 0.5 * (k1 + k2)).abs() < 1e-9 * k2, "{mean}");
+        assert!((gauss - k1 * k2).abs() < 1e-9 * k1 * k2, "{gauss}");
+        // Seen from inside (the inverted quadric), the curvature changes sign.
+        let inverted = FunctionalObject { base: Quadric::from_coefficients(e.base.coefficients().map(|v| -v)), ..e };
+        let (mean_in, gauss_in) = inverted.curvatures(DVec3::new(a, 0.0, 0.0));
+        assert!((mean_in + mean).abs() < 1e-9 * k2 && (gauss_in - gauss).abs() < 1e-9 * k1 * k2);
     }
 
     #[test]

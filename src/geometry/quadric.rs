@@ -72,6 +72,11 @@ impl Quadric {
         2.0 * (self.a * p) + self.b
     }
 
+    /// Hessian (constant): 2 A.
+    pub fn hessian(&self) -> DMat3 {
+        2.0 * self.a
+    }
+
     /// The restriction to the ray o + t d, as a quadratic in t.
     pub fn along_ray(&self, o: DVec3, d: DVec3) -> Quadratic {
         let ad = self.a * d;

@@ -147,6 +147,12 @@ pub struct GpuMaterial {
     pub displacement_map: u32,
     /// Height of a displacement value of 1, in object units.
     pub displacement_scale: f32,
+    /// Texture index of the normal map's slope moments
+    /// (`texture::lean::normal_slope_moments`), or `NO_TEXTURE`.
+    pub normal_moments: u32,
+    /// Texture index of the displacement map's slope moments
+    /// (`texture::lean::height_slope_moments`), or `NO_TEXTURE`.
+    pub displacement_moments: u32,
 }
 
 impl From<&Material> for GpuMaterial {
@@ -160,6 +166,8 @@ impl From<&Material> for GpuMaterial {
             roughness_map: m.maps.roughness.map_or(NO_TEXTURE, |i| i as u32),
             displacement_map: m.maps.displacement.map_or(NO_TEXTURE, |(i, _)| i as u32),
             displacement_scale: m.maps.displacement.map_or(0.0, |(_, s)| s),
+            normal_moments: NO_TEXTURE,
+            displacement_moments: NO_TEXTURE,
             ..Default::default()
         };
         match &m.kind {
@@ -314,8 +322,12 @@ pub struct GpuHit {
     pub normal: [f32; 3],
     /// Object index, or `NO_HIT`.
     pub object: u32,
+    /// Mean curvature of the outward normal (positive when convex), 1/length.
+    pub mean_curvature: f32,
+    /// Gaussian curvature, 1/length².
+    pub gauss_curvature: f32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: u32,
 }
 
 /// Push constants of render.comp.
@@ -330,6 +342,37 @@ pub struct RenderPush {
     pub sample_index: u32,
     /// 1 to write the AOVs in this dispatch.
     pub write_aov: u32,
+}
+
+/// One filtered texture lookup for texprobe.comp: a footprint (centre and
+/// 1σ semi-axes in (u, v)) and a GGX α to widen by the looked-up slope
+/// moments.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuTexQuery {
+    /// Texture index.
+    pub texture: u32,
+    /// GGX α before widening.
+    pub alpha: f32,
+    /// Footprint centre.
+    pub uv: [f32; 2],
+    /// First semi-axis.
+    pub axis1: [f32; 2],
+    /// Second semi-axis.
+    pub axis2: [f32; 2],
+}
+
+/// The result of a [`GpuTexQuery`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuTexResult {
+    /// The EWA-filtered texel value.
+    pub value: [f32; 4],
+    /// `leanAlpha(alpha, value)`: α widened by the slope variance of `value`
+    /// read as slope moments.
+    pub alpha: f32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 /// Push constants of probe.comp.
@@ -347,7 +390,7 @@ const _: () = {
     assert!(std::mem::size_of::<GpuObject>() == 92);
     assert!(std::mem::size_of::<GpuPerturbation>() == 60);
     assert!(std::mem::size_of::<GpuCell>() == 32);
-    assert!(std::mem::size_of::<GpuMaterial>() == 84);
+    assert!(std::mem::size_of::<GpuMaterial>() == 92);
     assert!(std::mem::size_of::<GpuLight>() == 56);
     assert!(std::mem::size_of::<GpuFrame>() == 96);
     assert!(std::mem::size_of::<GpuAov>() == 28);
@@ -355,4 +398,6 @@ const _: () = {
     assert!(std::mem::size_of::<GpuHit>() == 32);
     assert!(std::mem::size_of::<RenderPush>() == 24);
     assert!(std::mem::size_of::<ProbePush>() == 8);
+    assert!(std::mem::size_of::<GpuTexQuery>() == 32);
+    assert!(std::mem::size_of::<GpuTexResult>() == 32);
 };

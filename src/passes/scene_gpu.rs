@@ -2,6 +2,7 @@
 //! acceleration structure of procedural AABBs per object (one AABB per cell)
 //! and a top level with each object's transform.
 
+use std::collections::HashMap;
 use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
@@ -11,6 +12,7 @@ use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Scene, TextureImage};
 use crate::shader_interface::MAX_TEXTURES;
+use crate::texture::lean;
 use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
 use crate::RenderError;
 
@@ -48,7 +50,8 @@ pub struct GpuScene {
     pub lights: Buffer,
     /// Number of lights.
     pub light_count: u32,
-    /// The scene's texture maps, then a 1x1 white texture filling the
+    /// The scene's texture maps, then the slope moments derived from its
+    /// normal and displacement maps, then a 1x1 white texture filling the
     /// remaining slots of the shader's texture array.
     pub textures: Vec<Image>,
     /// The sampler for every texture.
@@ -159,11 +162,18 @@ impl GpuScene {
             .collect();
         let tlas = AccelerationStructure::top_level(device, cmds, &instances)?;
 
-        if scene.textures.len() >= MAX_TEXTURES as usize {
-            return Err(RenderError::TooManyTextures(scene.textures.len()));
+        let mut materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
+        let derived = derive_slope_moments(scene, &mut materials);
+        let texture_count = scene.textures.len() + derived.len();
+        if texture_count >= MAX_TEXTURES as usize {
+            return Err(RenderError::TooManyTextures(texture_count));
         }
-        let mut textures =
-            scene.textures.iter().map(|t| upload_texture(device, cmds, t)).collect::<Result<Vec<_>, _>>()?;
+        let mut textures = scene
+            .textures
+            .iter()
+            .chain(&derived)
+            .map(|t| upload_texture(device, cmds, t))
+            .collect::<Result<Vec<_>, _>>()?;
         let white = TextureImage { source: "white".into(), width: 1, height: 1, levels: vec![vec![[1.0; 4]]] };
         textures.push(upload_texture(device, cmds, &white)?);
         let (environment, env_cdf) = match scene.environment {
@@ -174,7 +184,6 @@ impl GpuScene {
             }
             None => (None, vec![0.0f32]),
         };
-        let materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
         let lights: Vec<GpuLight> = scene.lights.iter().map(GpuLight::from).collect();
 
         let stats = GeometryStats {
@@ -222,6 +231,31 @@ impl GpuScene {
             Binding::Buffer(&self.cell_lists),
         ]
     }
+}
+
+/// The slope-moment textures of the scene's normal and displacement maps
+/// (one per distinct map, LEAN filtering: `texture::lean`), numbered after
+/// the scene's textures; sets the materials' `normal_moments` and
+/// `displacement_moments` indices.
+fn derive_slope_moments(scene: &Scene, materials: &mut [GpuMaterial]) -> Vec<TextureImage> {
+    let mut derived = Vec::new();
+    let mut index_of: HashMap<(bool, usize), u32> = HashMap::new();
+    let mut moments_of = |is_normal: bool, map: usize| {
+        *index_of.entry((is_normal, map)).or_insert_with(|| {
+            let t = &scene.textures[map];
+            derived.push(if is_normal { lean::normal_slope_moments(t) } else { lean::height_slope_moments(t) });
+            (scene.textures.len() + derived.len() - 1) as u32
+        })
+    };
+    for (m, g) in scene.materials.iter().zip(materials) {
+        if let Some(map) = m.maps.normal {
+            g.normal_moments = moments_of(true, map);
+        }
+        if let Some((map, _)) = m.maps.displacement {
+            g.displacement_moments = moments_of(false, map);
+        }
+    }
+    derived
 }
 
 /// The camera basis of a scene for an image of the given size.

@@ -36,8 +36,11 @@
 //! row and v down the rows. A tangent-space normal map stores (n + 1) / 2 in
 //! RGB, where n's x component points along +u, y along +v and z out of the
 //! surface. Mip levels average texels in linear space, so a normal fetched
-//! from a coarse level is shorter than 1 and must be renormalised.
+//! from a coarse level is shorter than 1 and must be renormalised; filtered
+//! lookups of normal and displacement maps go through their slope moments
+//! instead ([`lean`]).
 
+pub mod lean;
 mod procedural;
 mod resample;
 

@@ -1,0 +1,51 @@
+#version 460
+// Filtered texture lookups on footprints given by the host: the GPU side of
+// the EWA and LEAN tests (tests/texfilter_gpu.rs), which compare them with
+// analytic averages and with the slope variance measured on the CPU.
+#extension GL_EXT_scalar_block_layout : require
+#extension GL_EXT_nonuniform_qualifier : require
+
+#include "common.glsl"
+
+layout(local_size_x = PROBE_GROUP) in;
+
+layout(set = 0, binding = 0) uniform sampler2D textures[MAX_TEXTURES];
+
+#include "texfilter.glsl"
+
+struct TexQuery {
+    uint texture;
+    float alpha;
+    vec2 uv;
+    vec2 axis1;
+    vec2 axis2;
+};
+
+struct TexResult {
+    vec4 value;
+    float alpha;
+    uint pad[3];
+};
+
+layout(set = 0, binding = 1, scalar) readonly buffer Queries { TexQuery queries[]; };
+layout(set = 0, binding = 2, scalar) writeonly buffer Results { TexResult results[]; };
+
+layout(push_constant, scalar) uniform Push {
+    uint first;
+    uint count;
+} pc;
+
+void main() {
+    if (gl_GlobalInvocationID.x >= pc.count) return;
+    uint i = pc.first + gl_GlobalInvocationID.x;
+    TexQuery q = queries[i];
+    Footprint fp;
+    fp.uv = q.uv;
+    fp.axis1 = q.axis1;
+    fp.axis2 = q.axis2;
+    TexResult r;
+    r.value = ewaLookup(q.texture, fp);
+    r.alpha = leanAlpha(q.alpha, r.value);
+    r.pad = uint[3](0u, 0u, 0u);
+    results[i] = r;
+}

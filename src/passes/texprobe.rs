@@ -1,0 +1,57 @@
+//! The texture probe pass: filtered lookups (EWA, LEAN widening) of a scene's
+//! textures on an explicit list of footprints. Used by the texture-filtering
+//! tests to compare the shader's filters with analytic answers.
+
+use std::sync::Arc;
+
+use super::gpu::{GpuTexQuery, GpuTexResult, ProbePush};
+use super::scene_gpu::GpuScene;
+use crate::shader_interface::{MAX_TEXTURES, PROBE_GROUP};
+use crate::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::{shaders, RenderError};
+
+/// Lookups per dispatch.
+const QUERIES_PER_DISPATCH: u32 = 1 << 14;
+
+/// A texture-lookup pass over a fixed list of footprints.
+pub struct TexProbePass {
+    pipeline: ComputePipeline,
+    _queries: Buffer,
+    results: Buffer,
+    count: u32,
+}
+
+impl TexProbePass {
+    /// Uploads `queries` and binds them with the scene's textures.
+    pub fn new(device: &Arc<Device>, scene: &GpuScene, queries: &[GpuTexQuery]) -> Result<Self, RenderError> {
+        let kinds = [BindingKind::SampledImages(MAX_TEXTURES), BindingKind::StorageBuffer, BindingKind::StorageBuffer];
+        let push_size = std::mem::size_of::<ProbePush>() as u32;
+        let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &kinds, push_size, &[])?;
+        let query_buf = Buffer::with_data(device, "texture queries", queries, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        let results = Buffer::new(
+            device,
+            "texture query results",
+            (queries.len().max(1) * std::mem::size_of::<GpuTexResult>()) as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        )?;
+        pipeline.bind(&[scene.texture_binding(), Binding::Buffer(&query_buf), Binding::Buffer(&results)]);
+        Ok(Self { pipeline, _queries: query_buf, results, count: queries.len() as u32 })
+    }
+
+    /// Runs every lookup and returns the results in query order.
+    pub fn run(&self, cmds: &mut Commands) -> Result<Vec<GpuTexResult>, RenderError> {
+        cmds.run(|_, cmd| {
+            let mut first = 0;
+            while first < self.count {
+                let n = (self.count - first).min(QUERIES_PER_DISPATCH);
+                let push = ProbePush { first, count: n };
+                self.pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [n.div_ceil(PROBE_GROUP), 1, 1]);
+                first += n;
+            }
+        })?;
+        let mut results: Vec<GpuTexResult> = self.results.read();
+        results.truncate(self.count as usize);
+        Ok(results)
+    }
+}

@@ -1,0 +1,249 @@
+//! The shader's texture filters (glsl/texfilter.glsl) on footprints given
+//! directly, against analytic answers:
+//!
+//! - EWA over the mip chain of a checkerboard against the exact average of
+//!   the (continuous) checkerboard under the same Gaussian footprint,
+//!   computed on the CPU by quadrature, for isotropic, anisotropic and
+//!   rotated footprints from a tenth of a texel to many checker cells;
+//! - LEAN filtering of a normal map of random bumps: the roughness after
+//!   filtering to the coarsest level against the one that the slope variance
+//!   measured on the CPU (from the height field, in f64) predicts.
+
+mod common;
+
+use glam::{DVec2, DVec3, Vec3};
+use quadray::geometry::{FunctionalObject, Quadric};
+use quadray::passes::gpu::GpuTexQuery;
+use quadray::passes::{GpuScene, TexProbePass};
+use quadray::scene::{Material, MaterialMaps};
+use quadray::texture::{bump_heights, checker, lean, normals_from_heights, TextureImage};
+use quadray::vk::Commands;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+/// Checkerboard: `SIZE` texels, `CELLS` cells a side, values 1 and 0 (red).
+const SIZE: u32 = 256;
+const CELLS: u32 = 16;
+
+/// EWA against the exact Gaussian average, |error| in units of the checker's
+/// contrast (1), for isotropic footprints whose σ is at least one texel. EWA
+/// adds the mip level's box filter and its own reconstruction filter (σ = ½
+/// texel of the level) to the footprint, which blurs a little more than the
+/// exact average where the footprint is about a checker cell wide.
+const EWA_TOLERANCE: f64 = 0.04;
+/// Anisotropic footprints: the tap budget (MAX_TAPS = 64 texels in the 3σ
+/// ellipse) forces a coarser level for long ellipses, whose blur widens the
+/// minor axis.
+const EWA_ANISOTROPIC_TOLERANCE: f64 = 0.08;
+/// Footprints below a texel: the filter reconstructs the texels (σ = ½
+/// texel) instead of point sampling the continuous checker, so near the cell
+/// edges the result differs by up to the texel's own blur.
+const EWA_SUBTEXEL_TOLERANCE: f64 = 0.3;
+/// Footprints of many cells: the average is ½.
+const EWA_WIDE_TOLERANCE: f64 = 0.005;
+/// LEAN at the coarsest level: relative error of the widened α.
+const LEAN_ALPHA_TOLERANCE: f64 = 0.01;
+
+/// The continuous checkerboard (1 in the cell at the origin).
+fn checker_at(uv: DVec2) -> f64 {
+    let c = (uv * CELLS as f64).floor();
+    if (c.x as i64 + c.y as i64).rem_euclid(2) == 0 {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// ∫ checker(uv + a1 s + a2 t) N(s) N(t) ds dt by the midpoint rule over ±4σ
+/// on an n x n grid (the standard normal's mass beyond 4σ is 6e-5).
+fn exact_average(uv: DVec2, a1: DVec2, a2: DVec2) -> f64 {
+    let n = 240;
+    let (mut sum, mut weights) = (0.0, 0.0);
+    for i in 0..n {
+        let s = -4.0 + 8.0 * (i as f64 + 0.5) / n as f64;
+        for j in 0..n {
+            let t = -4.0 + 8.0 * (j as f64 + 0.5) / n as f64;
+            let w = (-0.5 * (s * s + t * t)).exp();
+            sum += w * checker_at(uv + a1 * s + a2 * t);
+            weights += w;
+        }
+    }
+    sum / weights
+}
+
+/// A scene that holds the given textures (the object is never traced).
+fn texture_scene(textures: Vec<TextureImage>, maps: MaterialMaps) -> quadray::scene::Scene {
+    let sphere =
+        FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None };
+    let mut scene = common::scene_with(vec![common::object("sphere", sphere, glam::DAffine3::IDENTITY)]);
+    let mut m = Material::diffuse("mapped", Vec3::ONE);
+    m.maps = maps;
+    scene.materials = vec![m];
+    scene.textures = textures;
+    scene
+}
+
+fn query(texture: u32, uv: DVec2, a1: DVec2, a2: DVec2, alpha: f32) -> GpuTexQuery {
+    GpuTexQuery {
+        texture,
+        alpha,
+        uv: uv.as_vec2().to_array(),
+        axis1: a1.as_vec2().to_array(),
+        axis2: a2.as_vec2().to_array(),
+    }
+}
+
+#[test]
+fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
+    let scene = texture_scene(
+        vec![checker(SIZE, CELLS, [1.0, 0.0, 0.0], [0.0, 0.0, 0.0])],
+        MaterialMaps { albedo: Some(0), ..Default::default() },
+    );
+    let texel = 1.0 / SIZE as f64;
+    // (minor σ in texels, anisotropy) classes; random centres and angles.
+    let mut rng = Pcg64::seed_from_u64(11);
+    let mut cases = Vec::new();
+    for &(sigma, aniso) in
+        &[(0.1, 1.0), (0.4, 1.0), (1.0, 1.0), (2.0, 1.0), (4.0, 1.0), (8.0, 1.0), (16.0, 1.0), (2.0, 4.0), (4.0, 8.0)]
+    {
+        for _ in 0..24 {
+            let uv = DVec2::new(rng.gen(), rng.gen());
+            let angle: f64 = rng.gen_range(0.0..std::f64::consts::PI);
+            let (c, s) = (angle.cos(), angle.sin());
+            let a1 = DVec2::new(c, s) * sigma * aniso * texel;
+            let a2 = DVec2::new(-s, c) * sigma * texel;
+            cases.push((sigma, aniso, uv, a1, a2));
+        }
+    }
+    // Wide footprints: many cells under the 1σ ellipse.
+    for _ in 0..24 {
+        let uv = DVec2::new(rng.gen(), rng.gen());
+        cases.push((200.0, 1.0, uv, DVec2::new(200.0 * texel, 0.0), DVec2::new(0.0, 200.0 * texel)));
+    }
+    let queries: Vec<_> = cases.iter().map(|&(_, _, uv, a1, a2)| query(0, uv, a1, a2, 0.0)).collect();
+
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
+    let results = TexProbePass::new(&ctx.device, &gpu, &queries).unwrap().run(&mut cmds).unwrap();
+    drop(gpu);
+    drop(cmds);
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+
+    println!(
+        "{:>12} {:>8} {:>6} {:>12} {:>12} {:>10}",
+        "minor σ (tx)", "aniso", "cases", "max |error|", "mean |err|", "bound"
+    );
+    let mut failures = Vec::new();
+    let mut class = |sigma: f64, aniso: f64| {
+        let (mut max, mut sum, mut n) = (0.0f64, 0.0, 0);
+        for (k, &(s, a, uv, a1, a2)) in cases.iter().enumerate() {
+            if s != sigma || a != aniso {
+                continue;
+            }
+            let exact = exact_average(uv, a1, a2);
+            let got = results[k].value[0] as f64;
+            assert!(got.is_finite(), "non-finite lookup");
+            let err = (got - exact).abs();
+            max = max.max(err);
+            sum += err;
+            n += 1;
+        }
+        let bound = if sigma >= 100.0 {
+            EWA_WIDE_TOLERANCE
+        } else if sigma < 1.0 {
+            EWA_SUBTEXEL_TOLERANCE
+        } else if aniso > 1.0 {
+            EWA_ANISOTROPIC_TOLERANCE
+        } else {
+            EWA_TOLERANCE
+        };
+        println!("{sigma:>12} {aniso:>8} {n:>6} {max:>12.4} {:>12.4} {bound:>10}", sum / n as f64);
+        if max > bound {
+            failures.push(format!("σ {sigma} texels, anisotropy {aniso}: {max:.4} > {bound}"));
+        }
+    };
+    for &(sigma, aniso) in &[
+        (0.1, 1.0),
+        (0.4, 1.0),
+        (1.0, 1.0),
+        (2.0, 1.0),
+        (4.0, 1.0),
+        (8.0, 1.0),
+        (16.0, 1.0),
+        (2.0, 4.0),
+        (4.0, 8.0),
+        (200.0, 1.0),
+    ] {
+        class(sigma, aniso);
+    }
+    assert!(failures.is_empty(), "EWA beyond its bounds: {failures:?}");
+}
+
+/// Per-axis slope variance of the normal map `normals_from_heights(h, k)`,
+/// measured in f64 from the height field itself: slopes k·∂h (periodic
+/// central differences in texels), variance of each axis, averaged.
+fn measured_slope_variance(heights: &TextureImage, strength: f64) -> f64 {
+    let (w, h) = (heights.width as usize, heights.height as usize);
+    let at = |x: usize, y: usize| f64::from(heights.levels[0][y * w + x][0]);
+    let (mut sx, mut sy, mut sxx, mut syy) = (0.0, 0.0, 0.0, 0.0);
+    for y in 0..h {
+        for x in 0..w {
+            let dx = strength * (at((x + 1) % w, y) - at((x + w - 1) % w, y)) / 2.0;
+            let dy = strength * (at(x, (y + 1) % h) - at(x, (y + h - 1) % h)) / 2.0;
+            sx += dx;
+            sy += dy;
+            sxx += dx * dx;
+            syy += dy * dy;
+        }
+    }
+    let n = (w * h) as f64;
+    0.5 * ((sxx / n - (sx / n).powi(2)) + (syy / n - (sy / n).powi(2)))
+}
+
+#[test]
+fn lean_filtering_of_random_bumps_gives_the_predicted_roughness() {
+    let heights = bump_heights(256, 64, 7);
+    let alpha0 = 0.1f64;
+    let cases = [2.0f64, 6.0, 12.0];
+    let textures: Vec<_> = cases.iter().map(|&k| normals_from_heights(&heights, k as f32)).collect();
+    // Three materials so that each normal map gets its slope moments.
+    let mut scene = texture_scene(textures, MaterialMaps { normal: Some(0), ..Default::default() });
+    for i in 1..cases.len() {
+        let mut m = scene.materials[0].clone();
+        m.maps.normal = Some(i);
+        scene.materials.push(m);
+    }
+
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
+    // The moments follow the scene's textures, in material order.
+    let moments: Vec<u32> = (0..cases.len()).map(|i| (cases.len() + i) as u32).collect();
+    let huge = DVec2::new(50.0, 0.0);
+    let queries: Vec<_> = moments
+        .iter()
+        .map(|&t| query(t, DVec2::new(0.3, 0.6), huge, DVec2::new(huge.y, huge.x), alpha0 as f32))
+        .collect();
+    let results = TexProbePass::new(&ctx.device, &gpu, &queries).unwrap().run(&mut cmds).unwrap();
+    drop(gpu);
+    drop(cmds);
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+
+    println!("{:>9} {:>14} {:>12} {:>12} {:>10}", "strength", "slope var", "predicted α", "GPU α", "rel error");
+    for (k, (&strength, r)) in cases.iter().zip(&results).enumerate() {
+        let variance = measured_slope_variance(&heights, strength);
+        let predicted = lean::widened_alpha(alpha0, variance);
+        let got = f64::from(r.alpha);
+        let rel = (got - predicted).abs() / predicted;
+        println!("{strength:>9} {variance:>14.5} {predicted:>12.5} {got:>12.5} {rel:>10.2e}");
+        assert!(rel < LEAN_ALPHA_TOLERANCE, "case {k}: α {got} vs predicted {predicted}");
+        // The mean slope of periodic bumps is zero: the filtered normal is the
+        // surface normal.
+        assert!(r.value[0].abs() < 1e-3 && r.value[1].abs() < 1e-3, "mean slope {:?}", r.value);
+    }
+}
