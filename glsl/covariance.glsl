@@ -11,9 +11,9 @@
 //
 // Clamps (each keeps the matrix finite; none is active on ordinary paths):
 // - every entry is clamped to ±COV_MAX (1e12) after each operator, NaN -> 0;
-// - 1 / |cos θ| on a surface is bounded by 20 (grazing hits: the footprint's
-//   stretch along the surface is at most 20x), and cos θt in a refraction's
-//   angle scale by 0.05 likewise.
+// - 1 / |cos θ| on a surface is bounded by 1 / MIN_FOOTPRINT_COS = 1000
+//   (grazing hits: texfilter.glsl), and cos θt in a refraction's angle
+//   scale by 0.05 (the scale is at most 20η).
 #ifndef COVARIANCE_GLSL
 #define COVARIANCE_GLSL
 
@@ -72,7 +72,7 @@ void covRotate(inout PathCovariance c, vec3 e1n, vec3 e2n) {
 // component of t1 (the ray's direction projected on the surface) across the
 // ray and e2 = t2 = n × t1, and returns the spatial covariance on the
 // surface in the tangent basis (t1, t2): an offset x along e1 covers
-// x / |cos θ| along t1 (bounded at 20x). `inv` returns that 1 / |cos θ|.
+// x / |cos θ| along t1 (bounded: MIN_FOOTPRINT_COS). `inv` returns that 1 / |cos θ|.
 mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, out vec3 t1, out vec3 t2, out float inv) {
     vec3 along = d - n * dot(n, d);
     float al = length(along);
@@ -82,7 +82,7 @@ mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, out vec3 t1, out vec3 
     float el = length(e1n);
     e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, d));
     covRotate(c, e1n, t2);
-    inv = 1.0 / max(abs(dot(d, n)), 0.05);
+    inv = 1.0 / max(abs(dot(d, n)), MIN_FOOTPRINT_COS);
     return mat2(c.p[0][0] * inv * inv, c.p[0][1] * inv, c.p[1][0] * inv, c.p[1][1]);
 }
 

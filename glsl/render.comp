@@ -100,9 +100,9 @@ void footprintBasis(vec3 d, vec3 n, out vec3 t1, out vec3 t2) {
 }
 
 // A ray cone's footprint on the surface, in the basis (t1, t2): σ across the
-// ray, σ / |cos θ| along t1 (stretch bounded at 20).
+// ray, σ / |cos θ| along t1 (stretch bounded: MIN_FOOTPRINT_COS).
 mat2 coneFootprint(vec3 d, vec3 n, float sigma) {
-    float inv = 1.0 / max(abs(dot(d, n)), 0.05);
+    float inv = 1.0 / max(abs(dot(d, n)), MIN_FOOTPRINT_COS);
     return mat2(sigma * sigma * inv * inv, 0.0, 0.0, sigma * sigma);
 }
 
@@ -202,8 +202,9 @@ layout(push_constant, scalar) uniform Push {
     uint writeAov;
 } pc;
 
-// Specialisation constant for cost breakdowns (benchmark mode): SHADING_FULL
-// or SHADING_NONE (the first hit's albedo: no light sampling, no bounces).
+// Specialisation constant: SHADING_FULL, SHADING_NONE (the first hit's
+// albedo: no light sampling, no bounces; benchmark breakdowns) or
+// SHADING_MIRRORED_ALBEDO (the albedo seen through perfect mirrors; tests).
 layout(constant_id = 1) const uint SHADING_MODE = SHADING_FULL;
 
 // Bounces after which Russian roulette may end a path.
@@ -302,9 +303,10 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
     uint mediaCount = 0u;
     // Ray cone (Akenine-Möller et al., "Improved Shader and Texture Level of
     // Detail Using Ray Cones", JCGT 2021): width at the ray's origin and
-    // spread angle, starting from the pixel's angle at the camera. Rough and
-    // diffuse bounces widen the spread by twice their lobe's angular width
-    // (GGX α, 1 rad for Lambert): a heuristic; surface curvature is ignored.
+    // spread angle, starting from the pixel's angle at the camera. Curved
+    // surfaces turn the spread by their exact mean curvature (below); rough
+    // and diffuse bounces widen it by twice their lobe's angular width (GGX
+    // α, 1 rad for Lambert), a heuristic.
     float coneWidth = 0.0;
     float pixelAngle = 2.0 * length(frame.up) / float(frame.height);
     float coneSpread = pixelAngle;
@@ -347,6 +349,9 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         }
         Material mat = surfaceAt(h, d, footprint, ns);
         if (SHADING_MODE == SHADING_NONE) return v3(mat.albedo);
+        if (SHADING_MODE == SHADING_MIRRORED_ALBEDO && mat.kind != MATERIAL_MIRROR) {
+            return throughput * v3(mat.albedo);
+        }
         uint matIndex = objects[h.object].material;
         bool entering = dot(d, h.normal) < 0.0;
         if (mat.kind == MATERIAL_DIELECTRIC) {
@@ -392,10 +397,12 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
         if (!bs.valid) break;
-        coneWidth = width;
-        if (!isDelta(mat)) coneSpread += 2.0 * (mat.kind == MATERIAL_DIFFUSE ? 1.0 : materialAlpha(mat));
-        if (FILTER_MODE == FILTER_COVARIANCE) {
-            vec3 wiWorld = normalize(frameW * bs.wi);
+        if (FILTER_MODE != FILTER_NONE) {
+            // The outgoing footprint: the normal facing the incoming ray tilts
+            // by S u at surface offset u (S: its shape operator, exact from
+            // the Hessian of F'), which turns the outgoing direction by the
+            // gains g ⊙ (S u) (covariance.glsl, covBounce); refraction also
+            // scales the angles.
             bool transmitted = bs.wi.z * wo.z < 0.0;
             float cosI = abs(wo.z), cosT = max(abs(bs.wi.z), 0.05);
             vec2 scale = vec2(1.0), gain = vec2(2.0, 2.0 * cosI);
@@ -407,12 +414,26 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
             } else if (mat.kind == MATERIAL_DIFFUSE) {
                 gain = vec2(1.0);
             }
-            // The shape operator of the normal facing the incoming ray.
-            mat2 shape = shapeOperator(h, ct1, ct2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
-            // Angular standard deviation of the lobe: about √2 α for GGX
-            // reflection, about 0.6 rad for Lambert, 0 for delta lobes.
-            float lobe = isDelta(mat) ? 0.0 : (mat.kind == MATERIAL_DIFFUSE ? 0.6 : 1.41421356 * materialAlpha(mat));
-            covBounce(cov, covInv, ct1, ct2, wiWorld, scale, shape, gain, lobe);
+            vec3 t1, t2;
+            footprintBasis(d, h.normal, t1, t2);
+            mat2 shape = shapeOperator(h, t1, t2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
+            if (FILTER_MODE == FILTER_COVARIANCE) {
+                // Angular standard deviation of the lobe: about √2 α for GGX
+                // reflection, about 0.6 rad for Lambert, 0 for delta lobes.
+                float lobe =
+                    isDelta(mat) ? 0.0 : (mat.kind == MATERIAL_DIFFUSE ? 0.6 : 1.41421356 * materialAlpha(mat));
+                covBounce(cov, covInv, ct1, ct2, normalize(frameW * bs.wi), scale, shape, gain, lobe);
+            } else {
+                // Ray cones: the curvature term of Akenine-Möller et al. 2021
+                // (the cone's edge rays turn by the gain times the mean
+                // curvature times the width; a convex mirror of radius R
+                // adds 2w/R), then the angle scale of a refraction, then the
+                // lobe's widening.
+                float kappa = 0.5 * (shape[0][0] + shape[1][1]);
+                coneSpread = coneSpread * scale.x + 0.5 * (gain.x + gain.y) * kappa * width;
+                if (!isDelta(mat)) coneSpread += 2.0 * (mat.kind == MATERIAL_DIFFUSE ? 1.0 : materialAlpha(mat));
+                coneWidth = width;
+            }
         }
         if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) {
             // Transmitted: update the stack of media.

@@ -13,6 +13,11 @@ struct Footprint {
     vec2 axis2;
 };
 
+// A footprint meeting a surface at grazing incidence stretches along it by
+// 1 / |cos θ|, bounded at 1 / MIN_FOOTPRINT_COS (beyond 89.94°); the
+// anisotropy bound below then widens the minor axis to match.
+const float MIN_FOOTPRINT_COS = 1e-3;
+
 // The longest axis of the footprint may be at most this many times the shortest.
 const float MAX_ANISOTROPY = 16.0;
 // A lookup reads at most about this many texels (the level rises until it does).

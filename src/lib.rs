@@ -9,8 +9,10 @@
 //! - [`output`]: PNG and EXR files, written atomically.
 
 pub mod covariance;
+pub mod filter_bench;
 pub mod geometry;
 pub mod hash;
+pub mod metrics;
 pub mod output;
 pub mod passes;
 pub mod plot;

@@ -23,6 +23,50 @@ struct Cli {
 enum Command {
     /// Render a scene file (or the built-in default scene) to an image.
     Render(RenderArgs),
+    /// Measure the texture-filtering modes' speed/accuracy trade against a
+    /// brute-force reference: FLIP and relative MSE against GPU time (JSON,
+    /// Markdown and PNG plots), the time each mode takes to reach the error
+    /// of `none` at the largest spp, and temporal stability over a camera pan.
+    FilterBench(FilterBenchArgs),
+}
+
+#[derive(Parser, Debug)]
+struct FilterBenchArgs {
+    /// Scene files (default: the two figure-1 scenes).
+    #[arg(default_values = ["scenes/figure1_left.toml", "scenes/figure1_right.toml"])]
+    scenes: Vec<PathBuf>,
+    /// Output folder (created if missing); references are cached in its `cache/`.
+    #[arg(short, long, default_value = "results/filtering")]
+    out: PathBuf,
+    /// Image width.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(8..=4096))]
+    width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 192, value_parser = clap::value_parser!(u32).range(8..=4096))]
+    height: u32,
+    /// Samples per pixel of the reference (filtering `none`).
+    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    reference_spp: u32,
+    /// Each mode renders at 1, 2, 4, … up to this many samples per pixel.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    max_spp: u32,
+    /// Frames of the camera pan for temporal stability (0 skips it).
+    #[arg(long, default_value_t = 8)]
+    frames: u32,
+    /// Samples per pixel of each mode's pan frames.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    frame_spp: u32,
+    /// Samples per pixel of the reference pan frames.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    reference_frame_spp: u32,
+    /// Camera motion per pan frame, as a fraction of the camera's distance to
+    /// its look-at point, along its right vector (0.004 is about a pixel at
+    /// the look-at distance for a 192-pixel-high, 40° view).
+    #[arg(long, default_value_t = 0.004)]
+    pan_step: f64,
+    /// Enable the Khronos validation layer (fails on any error).
+    #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
+    validation: bool,
 }
 
 #[derive(Parser, Debug, Default)]
@@ -274,11 +318,57 @@ fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> Result<quadr
     Ok(full.expect("the full render"))
 }
 
+fn filter_bench(args: FilterBenchArgs) -> Result<()> {
+    for s in &args.scenes {
+        if !s.is_file() {
+            bail!("scene file {} not found", s.display());
+        }
+    }
+    let command = std::iter::once("quadray".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
+    let config = quadray::filter_bench::Config {
+        scenes: args.scenes,
+        out_dir: args.out,
+        width: args.width,
+        height: args.height,
+        reference_spp: args.reference_spp,
+        max_spp: args.max_spp,
+        frames: args.frames,
+        frame_spp: args.frame_spp,
+        reference_frame_spp: args.reference_frame_spp,
+        pan_step: args.pan_step,
+        command,
+    };
+    let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
+    let counters = ctx.counters();
+    let reports = quadray::filter_bench::run(&ctx, &config)?;
+    for r in &reports {
+        for h in &r.headline {
+            eprintln!(
+                "{}: {:>10} reaches FLIP {:.4} (none @ {} spp) in {}",
+                r.scene,
+                h.mode,
+                r.target_flip,
+                r.target_spp,
+                h.seconds_to_target.map_or("-- (not reached)".into(), |t| format!(
+                    "{t:.3} s: {:.2}x none",
+                    h.speedup_over_none.unwrap_or(0.0)
+                ))
+            );
+        }
+    }
+    drop(ctx);
+    if counters.errors() > 0 {
+        bail!("the validation layer reported {} error(s)", counters.errors());
+    }
+    Ok(())
+}
+
 fn main() -> Result<()> {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     match cli.command {
         Some(Command::Render(args)) => render(args),
+        Some(Command::FilterBench(args)) => filter_bench(args),
         None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),
     }
 }

@@ -77,6 +77,11 @@ pub const INTERSECT_BASE: u32 = 2;
 pub const SHADING_FULL: u32 = 0;
 /// Shading mode: the first hit's albedo only (benchmark breakdowns).
 pub const SHADING_NONE: u32 = 1;
+/// Shading mode: the albedo of the first hit that is not a perfect mirror,
+/// seen through perfect mirrors (times their reflectance); no lighting. With
+/// many samples per pixel and no filtering it is the exact pixel average of
+/// the textures seen directly and in mirrors (the filtering tests).
+pub const SHADING_MIRRORED_ALBEDO: u32 = 2;
 /// Texture filtering: bilinear lookups of mip level 0 (with many samples per
 /// pixel, the brute-force reference).
 pub const FILTER_NONE: u32 = 0;

@@ -1,0 +1,126 @@
+//! Image error metrics for comparing a render with a reference: FLIP (via
+//! the `nv-flip` crate: P. Andersson, J. Nilsson, T. Akenine-Möller et al.,
+//! "FLIP: A Difference Evaluator for Alternating Images", HPG 2020) on the
+//! tone-mapped 8-bit sRGB images, and the relative mean squared error on the
+//! linear radiance.
+
+use crate::output::tone_map;
+use crate::passes::RenderOutput;
+
+/// Pixels per degree of the FLIP observer: a 0.7 m viewing distance from a
+/// 0.7 m wide monitor of 3840 pixels (FLIP's default).
+pub const FLIP_PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
+
+/// The ε of [`relative_mse`], keeping dark pixels from dominating.
+pub const RELATIVE_MSE_EPSILON: f64 = 1e-2;
+
+/// Why two images cannot be compared.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum MetricError {
+    /// The images differ in size.
+    #[error("image sizes differ: {0}x{1} and {2}x{3}")]
+    SizeMismatch(u32, u32, u32, u32),
+    /// An image has no pixel.
+    #[error("empty image")]
+    Empty,
+}
+
+fn check_sizes(a: &RenderOutput, b: &RenderOutput) -> Result<(), MetricError> {
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(MetricError::SizeMismatch(a.width, a.height, b.width, b.height));
+    }
+    if a.radiance.is_empty() {
+        return Err(MetricError::Empty);
+    }
+    Ok(())
+}
+
+/// The FLIP error map of `test` against `reference`, both tone-mapped as the
+/// PNG outputs are (radiance · 2^exposure, clamped, sRGB), one value in
+/// [0, 1] per pixel.
+pub fn flip_map(reference: &RenderOutput, test: &RenderOutput, exposure: f32) -> Result<Vec<f32>, MetricError> {
+    check_sizes(reference, test)?;
+    let r = nv_flip::FlipImageRgb8::with_data(reference.width, reference.height, &tone_map(reference, exposure));
+    let t = nv_flip::FlipImageRgb8::with_data(test.width, test.height, &tone_map(test, exposure));
+    Ok(nv_flip::flip(r, t, FLIP_PIXELS_PER_DEGREE).to_vec())
+}
+
+/// Mean FLIP error of `test` against `reference` (0: identical; see [`flip_map`]).
+pub fn flip_mean(reference: &RenderOutput, test: &RenderOutput, exposure: f32) -> Result<f64, MetricError> {
+    let map = flip_map(reference, test, exposure)?;
+    Ok(map.iter().map(|&v| f64::from(v)).sum::<f64>() / map.len() as f64)
+}
+
+/// Relative mean squared error of the linear radiance: the mean over pixels
+/// and channels of (test − ref)² / (ref² + ε), ε = [`RELATIVE_MSE_EPSILON`].
+pub fn relative_mse(reference: &RenderOutput, test: &RenderOutput) -> Result<f64, MetricError> {
+    check_sizes(reference, test)?;
+    let sum: f64 = reference
+        .radiance
+        .iter()
+        .zip(&test.radiance)
+        .flat_map(|(r, t)| r.iter().zip(t).map(|(&r, &t)| (f64::from(r), f64::from(t))))
+        .map(|(r, t)| (t - r) * (t - r) / (r * r + RELATIVE_MSE_EPSILON))
+        .sum();
+    Ok(sum / (3 * reference.radiance.len()) as f64)
+}
+
+/// Mean absolute difference of the tone-mapped images (values in [0, 1]
+/// per channel): the frame-to-frame change of an animation as a viewer sees it.
+pub fn mean_display_change(a: &RenderOutput, b: &RenderOutput, exposure: f32) -> Result<f64, MetricError> {
+    check_sizes(a, b)?;
+    let (ta, tb) = (tone_map(a, exposure), tone_map(b, exposure));
+    let sum: u64 = ta.iter().zip(&tb).map(|(&x, &y)| u64::from(x.abs_diff(y))).sum();
+    Ok(sum as f64 / (255.0 * ta.len() as f64))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> RenderOutput {
+        let radiance = (0..width * height).map(|i| f(i % width, i / width)).collect();
+        RenderOutput { width, height, radiance, aov: vec![], spp: 1, seconds: 0.0 }
+    }
+
+    #[test]
+    fn identical_images_have_no_error() {
+        let a = image(32, 24, |x, y| [x as f32 / 32.0, y as f32 / 24.0, 0.5]);
+        assert_eq!(flip_mean(&a, &a, 0.0).unwrap(), 0.0);
+        assert_eq!(relative_mse(&a, &a).unwrap(), 0.0);
+        assert_eq!(mean_display_change(&a, &a, 0.0).unwrap(), 0.0);
+    }
+
+    #[test]
+    fn errors_grow_with_the_difference() {
+        let a = image(64, 64, |_, _| [0.5; 3]);
+        let noisy = |amp: f32| {
+            image(64, 64, |x, y| {
+                let s = if (x * 7 + y * 13) % 2 == 0 { amp } else { -amp };
+                [0.5 + s; 3]
+            })
+        };
+        let (small, large) = (noisy(0.05), noisy(0.2));
+        assert!(flip_mean(&a, &small, 0.0).unwrap() > 0.0);
+        assert!(flip_mean(&a, &large, 0.0).unwrap() > flip_mean(&a, &small, 0.0).unwrap());
+        // (0.05)² / (0.25 + 0.01) per channel.
+        assert!((relative_mse(&a, &small).unwrap() - 0.0025 / 0.26).abs() < 1e-6);
+        assert!(relative_mse(&a, &large).unwrap() > relative_mse(&a, &small).unwrap());
+    }
+
+    #[test]
+    fn display_change_of_a_shift_is_the_contrast_fraction() {
+        // Black and white halves; shifting the edge by 4 of 64 columns changes
+        // 4/64 of the pixels by the full range.
+        let a = image(64, 8, |x, _| if x < 32 { [0.0; 3] } else { [1.0; 3] });
+        let b = image(64, 8, |x, _| if x < 36 { [0.0; 3] } else { [1.0; 3] });
+        assert!((mean_display_change(&a, &b, 0.0).unwrap() - 4.0 / 64.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn size_mismatch_is_an_error() {
+        let a = image(4, 4, |_, _| [0.0; 3]);
+        let b = image(4, 5, |_, _| [0.0; 3]);
+        assert_eq!(flip_mean(&a, &b, 0.0), Err(MetricError::SizeMismatch(4, 4, 4, 5)));
+    }
+}
