@@ -30,12 +30,12 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::CellParams;
-use crate::metrics::{flip_mean, mean_display_change, relative_mse, MetricError};
+use crate::metrics::{change_error, flip_mean, mean_display_change, relative_mse, MetricError};
 use crate::output::{write_all_or_nothing, write_png};
 use crate::passes::{render, GpuScene, RenderOutput, RenderVariant};
 use crate::plot::{write_log_log_plot, HLine, PlotError, Series};
 use crate::scene::{load_scene, Scene};
-use crate::shader_interface::{FILTER_COVARIANCE, FILTER_NONE, FILTER_RAY_CONES};
+use crate::shader_interface::{FILTER_COVARIANCE, FILTER_NONE, FILTER_RAY_CONES, SHADING_FULL};
 use crate::vk::{Commands, Context};
 use crate::RenderError;
 
@@ -67,6 +67,11 @@ pub struct Config {
     /// Camera motion per frame, as a fraction of the distance from the
     /// camera to its look-at point, along the camera's right vector.
     pub pan_step: f64,
+    /// The render shader's shading: `SHADING_FULL` (the path tracer) or
+    /// `SHADING_MIRRORED_ALBEDO` (texture transport alone: the albedo seen
+    /// directly and through perfect mirrors, no lighting, no noise but the
+    /// pixel's own).
+    pub shading: u32,
     /// The command line, recorded in the reports.
     pub command: String,
 }
@@ -135,6 +140,9 @@ pub struct Headline {
     pub seconds_to_target: Option<f64>,
     /// `none`'s time at its largest spp over this mode's time to the target.
     pub speedup_over_none: Option<f64>,
+    /// True when the mode's first (1-spp) render was already at or below the
+    /// target: the time is then an upper bound (the speed-up a lower bound).
+    pub reached_at_first_point: bool,
     /// The lowest FLIP this mode reached, and at what spp.
     pub best_flip: f64,
     /// The spp of `best_flip`.
@@ -153,6 +161,9 @@ pub struct Stability {
     pub mean_change: f64,
     /// `mean_change` over the reference's.
     pub ratio_to_reference: f64,
+    /// Mean over consecutive frame pairs of the change the reference's
+    /// change does not explain ([`change_error`]): flicker and lost motion.
+    pub change_error: f64,
 }
 
 /// Everything measured on one scene.
@@ -199,6 +210,9 @@ pub struct ReferenceInfo {
     pub seed: u32,
     /// Camera offset along its right vector (temporal frames), scene units.
     pub camera_offset: f64,
+    /// The shading variant (`SHADING_*`).
+    #[serde(default)]
+    pub shading: u32,
     /// Renderer version.
     pub version: String,
     /// Seconds it took (not part of the key).
@@ -252,7 +266,8 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Vec<SceneReport>, BenchErro
     }
     let summary = config.out_dir.join("summary.md");
     let text = summary_markdown(config, &reports);
-    write_all_or_nothing(std::slice::from_ref(&summary), |_, p| std::fs::write(p, &text)).map_err(io_error(&summary))?;
+    write_all_or_nothing(std::slice::from_ref(&summary), |_, p| std::fs::write(p, &text))
+        .map_err(io_error(&summary))?;
     eprintln!("wrote {}", summary.display());
     Ok(reports)
 }
@@ -264,6 +279,7 @@ struct Bench<'a> {
     gpu: GpuScene,
     scene: Scene,
     size: (u32, u32),
+    shading: u32,
 }
 
 impl Bench<'_> {
@@ -276,14 +292,14 @@ impl Bench<'_> {
         let right = (c.look_at - c.position).cross(c.up).normalize_or(DVec3::X);
         c.position += right * offset;
         c.look_at += right * offset;
-        let variant = RenderVariant { filter, ..Default::default() };
+        let variant = RenderVariant { filter, shading: self.shading, ..Default::default() };
         let (w, h) = self.size;
         Ok(render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, (w, h, spp), variant, &mut |_, _| {})?)
     }
 
     /// A render with `filter` after an untimed warm-up of its shader variant.
     fn warm_up(&mut self, filter: u32) -> Result<(), BenchError> {
-        let variant = RenderVariant { filter, ..Default::default() };
+        let variant = RenderVariant { filter, shading: self.shading, ..Default::default() };
         render(&self.ctx.device, &mut self.cmds, &self.gpu, &self.scene, (8, 8, 1), variant, &mut |_, _| {})?;
         Ok(())
     }
@@ -302,9 +318,12 @@ fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result<SceneRepor
     let mut cmds = Commands::new(&ctx.device)?;
     let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &CellParams::default())?;
     let size = (config.width, config.height);
-    let mut bench = Bench { ctx, cmds, gpu, scene, size };
+    let mut bench = Bench { ctx, cmds, gpu, scene, size, shading: config.shading };
     let seed = bench.scene.image.seed;
     let cache = config.out_dir.join("cache");
+    if config.shading != SHADING_FULL {
+        eprintln!("{stem}: shading variant {}: texture transport alone, no lighting", config.shading);
+    }
     std::fs::create_dir_all(&cache).map_err(io_error(&cache))?;
 
     let key = |spp: u32, offset: f64| ReferenceInfo {
@@ -314,11 +333,15 @@ fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result<SceneRepor
         spp,
         seed,
         camera_offset: offset,
+        shading: config.shading,
         version: env!("CARGO_PKG_VERSION").into(),
         seconds: 0.0,
     };
-    let (reference, reference_info) =
-        cached_reference(&mut bench, &cache.join(format!("{stem}-reference")), key(config.reference_spp, 0.0))?;
+    let (reference, reference_info) = cached_reference(
+        &mut bench,
+        &cache.join(format!("{stem}-s{}-reference", config.shading)),
+        key(config.reference_spp, 0.0),
+    )?;
     let png = config.out_dir.join(format!("{stem}-reference.png"));
     write_png(&reference, exposure, &png).map_err(io_error(&png))?;
 
@@ -361,6 +384,7 @@ fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result<SceneRepor
             let best = mine.iter().min_by(|a, b| a.flip.total_cmp(&b.flip)).expect("runs");
             Headline {
                 mode: name.to_string(),
+                reached_at_first_point: points.first().is_some_and(|&(_, e)| e <= target_flip),
                 seconds_to_target: t,
                 speedup_over_none: t.map(|t| target_seconds / t),
                 best_flip: best.flip,
@@ -414,7 +438,7 @@ fn temporal_stability(
     };
     let mut reference_frames = Vec::new();
     for (k, &offset) in offsets.iter().enumerate() {
-        let path = cache.join(format!("{stem}-pan{k}"));
+        let path = cache.join(format!("{stem}-s{}-pan{k}", config.shading));
         reference_frames.push(cached_reference(bench, &path, key(config.reference_frame_spp, offset))?.0);
     }
     let reference_change = mean_change(&reference_frames)?;
@@ -423,6 +447,7 @@ fn temporal_stability(
         spp: config.reference_frame_spp,
         mean_change: reference_change,
         ratio_to_reference: 1.0,
+        change_error: 0.0,
     }];
     let seed = bench.scene.image.seed;
     for (name, filter) in MODES {
@@ -433,8 +458,15 @@ fn temporal_stability(
             frames.push(bench.render(filter, config.frame_spp, seed, offset)?);
         }
         let change = mean_change(&frames)?;
+        let mut error = 0.0;
+        for k in 1..frames.len() {
+            let (a, b) = (&frames[k - 1], &frames[k]);
+            error += change_error(a, b, &reference_frames[k - 1], &reference_frames[k], exposure)?;
+        }
+        error /= (frames.len() - 1) as f64;
         eprintln!(
-            "{stem}: pan, {name:>10} {} spp: mean change {change:.4} (reference {reference_change:.4})",
+            "{stem}: pan, {name:>10} {} spp: mean change {change:.4} (reference {reference_change:.4}), change error \
+             {error:.4}",
             config.frame_spp
         );
         rows.push(Stability {
@@ -442,6 +474,7 @@ fn temporal_stability(
             spp: config.frame_spp,
             mean_change: change,
             ratio_to_reference: change / reference_change.max(1e-12),
+            change_error: error,
         });
     }
     Ok(rows)
@@ -549,14 +582,16 @@ pub fn scene_markdown(r: &SceneReport) -> String {
     }
     let _ = writeln!(
         s,
-        "\nTarget: the FLIP of `none` at {} spp, {:.4} ({:.3} s).\n",
+        "\nTarget: the FLIP of `none` at {} spp, {:.4} ({:.3} s). Time to reach it: log-log interpolation between the \
+         measured points (≤: already reached at 1 spp, an upper bound).\n",
         r.target_spp, r.target_flip, r.target_seconds
     );
     let _ = writeln!(s, "| mode | seconds to target | speed-up over none | best FLIP (spp) |\n|---|---:|---:|---:|");
     for h in &r.headline {
+        let (le, ge) = if h.reached_at_first_point { ("≤ ", "≥ ") } else { ("", "") };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.4} ({}) |",
+            "| {} | {le}{} | {ge}{} | {:.4} ({}) |",
             h.mode,
             fmt_opt(h.seconds_to_target, 3),
             fmt_opt(h.speedup_over_none, 2),
@@ -567,10 +602,17 @@ pub fn scene_markdown(r: &SceneReport) -> String {
     if !r.stability.is_empty() {
         let _ = writeln!(
             s,
-            "\nTemporal stability (camera pan, mean frame-to-frame change of the displayed image):\n\n| mode | spp | mean change | ratio to reference |\n|---|---:|---:|---:|"
+            "\nTemporal stability (camera pan): mean frame-to-frame change of the displayed image, its ratio to \
+             the reference's, and the change error (the part of the change that the reference's change does not \
+             explain: flicker and lost motion; 0 is ideal):\n\n| mode | spp | mean change | ratio to reference | \
+             change error |\n|---|---:|---:|---:|---:|"
         );
         for st in &r.stability {
-            let _ = writeln!(s, "| {} | {} | {:.4} | {:.2} |", st.mode, st.spp, st.mean_change, st.ratio_to_reference);
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.4} | {:.2} | {:.4} |",
+                st.mode, st.spp, st.mean_change, st.ratio_to_reference, st.change_error
+            );
         }
     }
     s
@@ -633,6 +675,7 @@ mod tests {
             spp: 4,
             seed: 0,
             camera_offset: 0.0,
+            shading: 0,
             version: "1".into(),
             seconds: 3.0,
         };

@@ -64,9 +64,23 @@ struct FilterBenchArgs {
     /// the look-at distance for a 192-pixel-high, 40° view).
     #[arg(long, default_value_t = 0.004)]
     pan_step: f64,
+    /// What the renders compute: `full` (the path tracer) or `albedo` (texture
+    /// transport alone: the albedo seen directly and through perfect mirrors,
+    /// no lighting; isolates what filtering does from lighting noise).
+    #[arg(long, value_enum, default_value_t = BenchShading::Full)]
+    shading: BenchShading,
     /// Enable the Khronos validation layer (fails on any error).
     #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     validation: bool,
+}
+
+/// Shading of `filter-bench --shading`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum BenchShading {
+    /// The path tracer.
+    Full,
+    /// The albedo seen directly and through perfect mirrors, no lighting.
+    Albedo,
 }
 
 #[derive(Parser, Debug, Default)]
@@ -336,6 +350,10 @@ fn filter_bench(args: FilterBenchArgs) -> Result<()> {
         frame_spp: args.frame_spp,
         reference_frame_spp: args.reference_frame_spp,
         pan_step: args.pan_step,
+        shading: match args.shading {
+            BenchShading::Full => quadray::shader_interface::SHADING_FULL,
+            BenchShading::Albedo => quadray::shader_interface::SHADING_MIRRORED_ALBEDO,
+        },
         command,
     };
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;

@@ -74,6 +74,32 @@ pub fn mean_display_change(a: &RenderOutput, b: &RenderOutput, exposure: f32) ->
     Ok(sum as f64 / (255.0 * ta.len() as f64))
 }
 
+/// Temporal error of an animation pair: the mean over pixels and channels
+/// of |(b − a) − (b_ref − a_ref)| on the tone-mapped images (values in
+/// [0, 1]): the frame-to-frame change that the reference's change (the
+/// motion itself) does not explain, i.e. flicker (noise, aliasing) and lost
+/// motion (blur).
+pub fn change_error(
+    a: &RenderOutput,
+    b: &RenderOutput,
+    a_ref: &RenderOutput,
+    b_ref: &RenderOutput,
+    exposure: f32,
+) -> Result<f64, MetricError> {
+    check_sizes(a, b)?;
+    check_sizes(a, a_ref)?;
+    check_sizes(a, b_ref)?;
+    let [ta, tb, ra, rb] = [a, b, a_ref, b_ref].map(|o| tone_map(o, exposure));
+    let sum: f64 = (0..ta.len())
+        .map(|i| {
+            let change = f64::from(tb[i]) - f64::from(ta[i]);
+            let reference = f64::from(rb[i]) - f64::from(ra[i]);
+            (change - reference).abs()
+        })
+        .sum();
+    Ok(sum / (255.0 * ta.len() as f64))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,6 +141,15 @@ mod tests {
         let a = image(64, 8, |x, _| if x < 32 { [0.0; 3] } else { [1.0; 3] });
         let b = image(64, 8, |x, _| if x < 36 { [0.0; 3] } else { [1.0; 3] });
         assert!((mean_display_change(&a, &b, 0.0).unwrap() - 4.0 / 64.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn change_error_ignores_the_motion_the_reference_shows() {
+        let a = image(64, 8, |x, _| if x < 32 { [0.0; 3] } else { [1.0; 3] });
+        let b = image(64, 8, |x, _| if x < 36 { [0.0; 3] } else { [1.0; 3] });
+        assert_eq!(change_error(&a, &b, &a, &b, 0.0).unwrap(), 0.0);
+        // A render that does not move at all misses the whole change.
+        assert!((change_error(&a, &a, &a, &b, 0.0).unwrap() - 4.0 / 64.0).abs() < 1e-12);
     }
 
     #[test]
