@@ -45,6 +45,7 @@ fn sphere_scene(n: usize) -> Scene {
         lights: vec![],
         textures: vec![],
         environment: None,
+        fog: None,
     }
 }
 

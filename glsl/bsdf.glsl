@@ -6,8 +6,8 @@
 #define BSDF_GLSL
 
 #include "common.glsl"
+#include "media.glsl"
 
-const float PI = 3.14159265358979;
 // Below this GGX α a lobe is treated as a perfect specular (delta) lobe.
 const float ALPHA_DELTA = 1e-3;
 
@@ -27,6 +27,7 @@ struct Material {
     float displacementScale;  // object units per unit of displacement
     uint normalMoments;       // slope moments of the normal map (texture/lean.rs), or NO_TEXTURE
     uint displacementMoments; // slope moments of the displacement map, or NO_TEXTURE
+    Medium medium;            // inside a dielectric (density 0: clear)
 };
 
 vec3 sampleCosineHemisphere(vec2 u) {

@@ -2,6 +2,8 @@
 #ifndef COMMON_GLSL
 #define COMMON_GLSL
 
+const float PI = 3.14159265358979;
+
 // "No root / no hit" distance.
 const float NO_ROOT = 3.402823e38;
 

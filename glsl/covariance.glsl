@@ -125,4 +125,17 @@ void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, vec
     c.e2 = e2n;
 }
 
+// A scattering event in a medium, into direction wi: the bundle's spatial
+// offsets are kept, projected across wi (first order), and the phase lobe's
+// angular standard deviation σ widens the angles.
+void covScatter(inout PathCovariance c, vec3 wi, float sigma) {
+    vec3 e1n = c.e1 - wi * dot(wi, c.e1);
+    float l = length(e1n);
+    e1n = l > 1e-6 ? e1n / l : frameAround(wi)[0];
+    covRotate(c, e1n, cross(wi, e1n));
+    c.p[2][2] += sigma * sigma;
+    c.p[3][3] += sigma * sigma;
+    c.p = covClamp(c.p);
+}
+
 #endif

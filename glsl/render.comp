@@ -31,6 +31,7 @@ layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
     uint envWidth;
     uint envHeight;
     float envScale;
+    Medium fog;       // outside the objects (density 0: none)
 } frame;
 
 // rgb: summed radiance, a: sample count.
@@ -257,7 +258,7 @@ uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
 // Next-event estimation at a vertex with a non-delta material: one light
 // chosen uniformly. `mis` is false at the last vertex, where no BSDF-sampled
 // continuation competes.
-vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, inout uint rng) {
+vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, Medium med, bool mis, inout uint rng) {
     uint choices = lightChoices();
     if (choices == 0u) return vec3(0.0);
     uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
@@ -280,11 +281,65 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, bool mis, in
         uint first = firstLightHit(origin, ls.wi, dist, i, tl);
         if (first != frame.lightCount) return vec3(0.0);
     }
-    vec3 contribution = f * abs(wiLocal.z) * ls.radiance / select;
+    // The medium around the vertex attenuates the shadow ray (a shadow ray
+    // that would cross into another medium meets its boundary and is
+    // occluded above).
+    vec3 contribution = f * abs(wiLocal.z) * ls.radiance * (transmittance(med, dist) / select);
     if (ls.pdf == 0.0) return contribution;  // delta light
     float pl = ls.pdf * select;
     float w = mis ? powerHeuristic(pl, bsdfPdf(mat, wo, wiLocal)) : 1.0;
     return contribution * (w / ls.pdf);
+}
+
+// Next-event estimation at a scattering event in a medium, at p, for a path
+// travelling along d: the phase function replaces the BSDF and the cosine,
+// the shadow ray is attenuated by the medium's transmittance.
+vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, bool mis, inout uint rng) {
+    uint choices = lightChoices();
+    if (choices == 0u) return vec3(0.0);
+    uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
+    float select = 1.0 / float(choices);
+    LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
+    if (!ls.valid) return vec3(0.0);
+    float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
+    float tr = transmittance(med, ls.dist);
+    if (tr == 0.0 || occluded(p, ls.wi, 0.0, ls.dist)) return vec3(0.0);
+    {
+        float tl;
+        uint first = firstLightHit(p, ls.wi, ls.dist, i, tl);
+        if (first != frame.lightCount) return vec3(0.0);
+    }
+    vec3 contribution = phase * tr * ls.radiance / select;
+    if (ls.pdf == 0.0) return contribution;  // delta light
+    float w = mis ? powerHeuristic(ls.pdf * select, phase) : 1.0;
+    return contribution * (w / ls.pdf);
+}
+
+// The media as local values (copied field by field: glslang mis-types a
+// direct copy of structs between blocks of different layouts).
+Medium materialMedium(uint material) {
+    Medium m;
+    m.density = materials[material].medium.density;
+    m.albedo = materials[material].medium.albedo;
+    m.anisotropy = materials[material].medium.anisotropy;
+    return m;
+}
+
+Medium fogMedium() {
+    Medium m;
+    m.density = frame.fog.density;
+    m.albedo = frame.fog.albedo;
+    m.anisotropy = frame.fog.anisotropy;
+    return m;
+}
+
+// Russian roulette after RR_DEPTH bounces: false when the path ends.
+bool survives(inout vec3 throughput, uint bounce, inout uint rng) {
+    if (bounce + 1u < RR_DEPTH) return true;
+    float q = clamp(max(throughput.x, max(throughput.y, throughput.z)), 0.05, 0.95);
+    if (rand(rng) > q) return false;
+    throughput /= q;
+    return true;
 }
 
 // Nested dielectrics: the path keeps a stack of the dielectric materials it
@@ -324,6 +379,40 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         SceneHit h = traceScene(o, d, 0.0, 1e30);
         float tl;
         uint which = firstLightHit(o, d, h.object == NO_HIT ? 1e30 : h.t, frame.lightCount, tl);
+        // Participating media: the medium the ray travels in (the innermost
+        // dielectric's interior, else the fog) may scatter or absorb it
+        // before it reaches the surface or light at tl (distance sampling:
+        // the event's weight is the albedo; passing through weighs 1).
+        Medium med = mediaCount > 0u ? materialMedium(media[mediaCount - 1u]) : fogMedium();
+        if (SHADING_MODE == SHADING_FULL && med.density > 0.0) {
+            float ts = -log(1.0 - rand(rng)) / med.density;
+            if (ts < tl) {
+                vec3 p = o + ts * d;
+                throughput *= v3(med.albedo);
+                bool last = bounce + 1u == frame.maxDepth;
+                radiance += throughput * mediumNextEvent(med, d, p, !last, rng);
+                if (last) break;
+                vec3 wi = sampleHg(med.anisotropy, d, rand2(rng));
+                lastPdf = hgPdf(med.anisotropy, dot(d, wi));
+                lastPoint = p;
+                // Footprints: travel to p, then the phase lobe widens the
+                // angles (its angular spread taken as √(1 − |g|) rad, a
+                // heuristic: 1 rad for isotropic scattering).
+                float phaseSigma = sqrt(1.0 - abs(med.anisotropy));
+                if (FILTER_MODE == FILTER_COVARIANCE) {
+                    covTravel(cov, ts);
+                    covScatter(cov, wi, phaseSigma);
+                } else if (FILTER_MODE == FILTER_RAY_CONES) {
+                    coneWidth += coneSpread * ts;
+                    coneSpread += 2.0 * phaseSigma;
+                }
+                d = wi;
+                o = p;
+                if (!survives(throughput, bounce, rng)) break;
+                ++bounce;
+                continue;
+            }
+        }
         if (which != frame.lightCount || h.object == NO_HIT) {
             // An emitter: a sphere or rect light, or the environment.
             vec3 le = which != frame.lightCount ? v3(lights[which].color) : environmentRadiance(d);
@@ -392,7 +481,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         mat3 frameW = frameAround(n);
         vec3 wo = transpose(frameW) * -d;
         bool last = bounce + 1u == frame.maxDepth;
-        if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, !last, rng);
+        if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, med, !last, rng);
         if (last) break;
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
@@ -455,11 +544,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         d = normalize(frameW * bs.wi);
         o = offsetOrigin(p, h.normal, d);
 
-        if (bounce + 1u >= RR_DEPTH) {
-            float q = clamp(max(throughput.x, max(throughput.y, throughput.z)), 0.05, 0.95);
-            if (rand(rng) > q) break;
-            throughput /= q;
-        }
+        if (!survives(throughput, bounce, rng)) break;
         ++bounce;
     }
     return radiance;

@@ -39,6 +39,7 @@ fn glossy_scene() -> Scene {
         albedo: Vec3::ONE,
         emission: Vec3::ZERO,
         maps: Default::default(),
+        medium: None,
     };
     scene.materials = vec![metal, Material::diffuse("floor", Vec3::splat(0.6))];
     scene.objects[1].material = 1;

@@ -56,7 +56,7 @@ struct TwinResult {
     dist: f32,
 }
 
-const _: () = assert!(std::mem::size_of::<TwinCase>() == 4 + 92 + 56 + 48);
+const _: () = assert!(std::mem::size_of::<TwinCase>() == 4 + 112 + 56 + 48);
 const _: () = assert!(std::mem::size_of::<TwinResult>() == 52);
 
 fn run_twins(cases: &[TwinCase]) -> Vec<TwinResult> {

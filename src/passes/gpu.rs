@@ -153,6 +153,30 @@ pub struct GpuMaterial {
     /// Texture index of the displacement map's slope moments
     /// (`texture::lean::height_slope_moments`), or `NO_TEXTURE`.
     pub displacement_moments: u32,
+    /// The medium inside (dielectrics; density 0: clear).
+    pub medium: GpuMedium,
+}
+
+/// `Medium` in media.glsl: a homogeneous medium (density 0: none).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuMedium {
+    /// Extinction σ_t per unit length.
+    pub density: f32,
+    /// Single-scattering albedo per RGB channel.
+    pub albedo: [f32; 3],
+    /// Henyey–Greenstein g.
+    pub anisotropy: f32,
+}
+
+impl From<Option<&crate::scene::Medium>> for GpuMedium {
+    fn from(m: Option<&crate::scene::Medium>) -> Self {
+        m.map_or_else(Self::default, |m| Self {
+            density: m.density,
+            albedo: m.albedo.to_array(),
+            anisotropy: m.anisotropy,
+        })
+    }
 }
 
 impl From<&Material> for GpuMaterial {
@@ -168,6 +192,7 @@ impl From<&Material> for GpuMaterial {
             displacement_scale: m.maps.displacement.map_or(0.0, |(_, s)| s),
             normal_moments: NO_TEXTURE,
             displacement_moments: NO_TEXTURE,
+            medium: GpuMedium::from(m.medium.as_ref()),
             ..Default::default()
         };
         match &m.kind {
@@ -284,6 +309,8 @@ pub struct GpuFrame {
     pub env_height: u32,
     /// Environment map radiance scale.
     pub env_scale: f32,
+    /// The medium outside the objects (fog; density 0: none).
+    pub fog: GpuMedium,
 }
 
 /// `Aov` in render.comp.
@@ -390,9 +417,10 @@ const _: () = {
     assert!(std::mem::size_of::<GpuObject>() == 92);
     assert!(std::mem::size_of::<GpuPerturbation>() == 60);
     assert!(std::mem::size_of::<GpuCell>() == 32);
-    assert!(std::mem::size_of::<GpuMaterial>() == 92);
+    assert!(std::mem::size_of::<GpuMaterial>() == 112);
+    assert!(std::mem::size_of::<GpuMedium>() == 20);
     assert!(std::mem::size_of::<GpuLight>() == 56);
-    assert!(std::mem::size_of::<GpuFrame>() == 96);
+    assert!(std::mem::size_of::<GpuFrame>() == 116);
     assert!(std::mem::size_of::<GpuAov>() == 28);
     assert!(std::mem::size_of::<GpuRay>() == 32);
     assert!(std::mem::size_of::<GpuHit>() == 32);

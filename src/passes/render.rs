@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::gpu::{GpuAov, GpuFrame, RenderPush};
+use super::gpu::{GpuAov, GpuFrame, GpuMedium, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use crate::scene::Scene;
 use crate::shader_interface::{FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
@@ -83,6 +83,7 @@ pub fn render(
         env_width: gpu.environment.map_or(0, |e| e.1),
         env_height: gpu.environment.map_or(0, |e| e.2),
         env_scale: gpu.environment.map_or(0.0, |e| e.3),
+        fog: GpuMedium::from(scene.fog.as_ref()),
     };
     let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
     let accum = Image::new(

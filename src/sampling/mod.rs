@@ -20,7 +20,8 @@
 //! [`fresnel`], [`bsdf`] (diffuse, conductor, mirror, smooth dielectric),
 //! [`lights`] (sphere, rectangle, directional, point and environment lights,
 //! the power heuristic), [`envmap`] (importance sampling of a lat-long
-//! environment map) and [`chi2`] (the chi-square test harness).
+//! environment map), [`phase`] (the Henyey–Greenstein phase function of
+//! participating media) and [`chi2`] (the chi-square test harness).
 
 pub mod bsdf;
 pub mod chi2;
@@ -28,6 +29,7 @@ pub mod envmap;
 pub mod fresnel;
 pub mod ggx;
 pub mod lights;
+pub mod phase;
 pub mod warp;
 
 pub use bsdf::{

@@ -33,7 +33,7 @@ use crate::hash::hash_unit;
 
 use super::{
     Camera, ConductorFresnel, EnvironmentMapSettings, ImageSettings, Light, Material, MaterialKind, MaterialMaps,
-    Scene, SceneObject, TextureImage, UvMapping, UvSettings,
+    Medium, Scene, SceneObject, TextureImage, UvMapping, UvSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 use crate::sampling::envmap::procedural_sky;
@@ -329,6 +329,11 @@ number_type!(
         require(v > 0.0, || format!("must be positive (got {v})"))?;
         require(v <= MAX_COLOUR, || format!("must be at most {MAX_COLOUR:e} (got {v})"))
     }
+);
+number_type!(
+    /// A Henyey–Greenstein asymmetry, in [−0.99, 0.99].
+    Anisotropy,
+    |v| require((-0.99..=0.99).contains(&v), || format!("must be between -0.99 and 0.99 (got {v})"))
 );
 number_type!(
     /// A number in [0, 1].
@@ -705,6 +710,7 @@ impl<'de, T: MapTable + Deserialize<'de>> Deserialize<'de> for RawMap<T> {
 struct RawScene {
     background: Option<Spanned<Triple<NonNegative>>>,
     environment: Option<Spanned<RawEnvironment>>,
+    fog: Option<Spanned<RawMedium>>,
     image: Option<RawImage>,
     camera: Spanned<RawCamera>,
     #[serde(default)]
@@ -724,6 +730,28 @@ struct RawImage {
     seed: Option<Seed>,
     exposure: Option<Exposure>,
     max_depth: Option<Depth>,
+}
+
+#[derive(Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a medium table such as { density = 0.2, albedo = [0.9, 0.9, 0.9], anisotropy = 0.3 }"
+)]
+struct RawMedium {
+    density: NonNegative,
+    albedo: Option<Triple<UnitInterval>>,
+    anisotropy: Option<Anisotropy>,
+}
+
+impl RawMedium {
+    /// The medium; the albedo defaults to 1 (no absorption), the anisotropy to 0.
+    fn build(&self) -> Medium {
+        Medium {
+            density: self.density.get() as f32,
+            albedo: self.albedo.map_or(Vec3::ONE, |a| a.get().as_vec3()),
+            anisotropy: self.anisotropy.map_or(0.0, |g| g.get() as f32),
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -800,7 +828,7 @@ const MATERIAL_KEYS: [(&str, &[&str]); 4] = [
     ),
     (
         "dielectric",
-        &["name", "type", "ior", "roughness", "emission", "roughness_map", "normal_map", "displacement_map"],
+        &["name", "type", "ior", "roughness", "emission", "roughness_map", "normal_map", "displacement_map", "medium"],
     ),
     ("mirror", &["name", "type", "albedo", "emission", "albedo_map", "normal_map", "displacement_map"]),
 ];
@@ -860,6 +888,7 @@ struct RawMaterial {
     normal_map: Option<Spanned<RawMap>>,
     roughness_map: Option<Spanned<RawMap>>,
     displacement_map: Option<Spanned<RawMap>>,
+    medium: Option<Spanned<RawMedium>>,
 }
 
 #[derive(Deserialize)]
@@ -1151,7 +1180,8 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
         None => None,
     };
 
-    Ok(Scene { image, camera, background, materials, objects, lights, environment, textures: textures.images })
+    let fog = raw.fog.as_ref().map(|f| f.get_ref().build());
+    Ok(Scene { image, camera, background, materials, objects, lights, environment, textures: textures.images, fog })
 }
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {
@@ -1527,6 +1557,7 @@ fn build_material(
             ("normal_map", span_of(&m.normal_map)),
             ("roughness_map", span_of(&m.roughness_map)),
             ("displacement_map", span_of(&m.displacement_map)),
+            ("medium", span_of(&m.medium)),
         ],
     )?;
     let albedo = |default: f32| m.albedo.as_ref().map_or(Vec3::splat(default), |a| a.get_ref().get().as_vec3());
@@ -1554,6 +1585,7 @@ fn build_material(
         albedo,
         emission: m.emission.as_ref().map_or(Vec3::ZERO, |e| e.get_ref().get().as_vec3()),
         maps: build_maps(src, &table, m, textures)?,
+        medium: m.medium.as_ref().map(|x| x.get_ref().build()),
     })
 }
 

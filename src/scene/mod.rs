@@ -96,6 +96,24 @@ pub struct Material {
     pub emission: Vec3,
     /// Texture maps (indices into [`Scene::textures`]).
     pub maps: MaterialMaps,
+    /// The participating medium filling the inside of a dielectric (water),
+    /// if any; clear when `None`.
+    pub medium: Option<Medium>,
+}
+
+/// A homogeneous participating medium (Henyey–Greenstein phase function).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Medium {
+    /// Extinction coefficient σ_t (per unit length), the same for every
+    /// colour: light travels 1 / density on average before it scatters or is
+    /// absorbed.
+    pub density: f32,
+    /// Single-scattering albedo σ_s / σ_t per RGB channel, each in [0, 1];
+    /// the rest of the extinction is absorption.
+    pub albedo: Vec3,
+    /// Henyey–Greenstein asymmetry g in [−0.99, 0.99]: > 0 forward, < 0
+    /// backward, 0 isotropic scattering.
+    pub anisotropy: f32,
 }
 
 /// The texture maps of a material, as indices into [`Scene::textures`].
@@ -122,6 +140,7 @@ impl Material {
             albedo,
             emission: Vec3::ZERO,
             maps: MaterialMaps::default(),
+            medium: None,
         }
     }
 }
@@ -250,6 +269,8 @@ pub struct Scene {
     pub textures: Vec<TextureImage>,
     /// An environment map replacing the uniform `background`, if any.
     pub environment: Option<EnvironmentMapSettings>,
+    /// A medium filling all space outside the objects (fog), if any.
+    pub fog: Option<Medium>,
 }
 
 /// A lat-long environment map: the radiance arriving from infinity, what

@@ -49,6 +49,7 @@ pub fn scene_with(objects: Vec<SceneObject>) -> Scene {
         lights: vec![Light::Point { position: DVec3::new(3.0, 6.0, 4.0), intensity: Vec3::splat(40.0) }],
         textures: vec![],
         environment: None,
+        fog: None,
     }
 }
 

@@ -1,0 +1,46 @@
+// Homogeneous participating media with the Henyey–Greenstein phase function
+// (CPU twin: src/sampling/phase.rs). A path travelling along d scatters into
+// w with density p(d · w); distances to the next interaction are sampled
+// exactly from the transmittance exp(−σ_t t) (σ_t is grey, so the weight of
+// a scattering event is the single-scattering albedo and that of passing
+// through is 1).
+#ifndef MEDIA_GLSL
+#define MEDIA_GLSL
+
+#include "common.glsl"
+
+struct Medium {
+    float density;     // σ_t per unit length; 0: no medium
+    float albedo[3];   // σ_s / σ_t per RGB channel
+    float anisotropy;  // g
+};
+
+const float HG_ISOTROPIC = 1e-3;
+const float HG_MAX_G = 0.99;
+
+float hgPdf(float g, float cosTheta) {
+    g = clamp(g, -HG_MAX_G, HG_MAX_G);
+    float denom = 1.0 + g * g - 2.0 * g * cosTheta;
+    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(denom));
+}
+
+// A scattered direction for a path travelling along d, from u in [0, 1)².
+vec3 sampleHg(float g, vec3 d, vec2 u) {
+    g = clamp(g, -HG_MAX_G, HG_MAX_G);
+    float cosTheta;
+    if (abs(g) < HG_ISOTROPIC) {
+        cosTheta = 1.0 - 2.0 * u.x;
+    } else {
+        float s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u.x);
+        cosTheta = clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
+    }
+    float sinTheta = sqrt(max(0.0, 1.0 - cosTheta * cosTheta));
+    float phi = 2.0 * PI * u.y;
+    mat3 f = frameAround(d);
+    return normalize(f[0] * (sinTheta * cos(phi)) + f[1] * (sinTheta * sin(phi)) + d * cosTheta);
+}
+
+// Transmittance over a distance (grey).
+float transmittance(Medium m, float dist) { return m.density > 0.0 ? exp(-m.density * dist) : 1.0; }
+
+#endif
