@@ -53,6 +53,10 @@ vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index
 
 #include "covariance.glsl"
 
+// Specialisation constant: 1 when the scene has a participating medium (the
+// fog or a dielectric's interior); 0 compiles the media code out.
+layout(constant_id = 3) const uint MEDIA_ENABLED = 0u;
+
 // Specialisation constant: FILTER_NONE, FILTER_RAY_CONES or FILTER_COVARIANCE.
 layout(constant_id = 2) const uint FILTER_MODE = FILTER_NONE;
 
@@ -292,13 +296,12 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, Medium med, 
 }
 
 // Next-event estimation at a scattering event in a medium, at p, for a path
-// travelling along d: the phase function replaces the BSDF and the cosine,
-// the shadow ray is attenuated by the medium's transmittance.
-vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, bool mis, inout uint rng) {
-    uint choices = lightChoices();
-    if (choices == 0u) return vec3(0.0);
-    uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
-    float select = 1.0 / float(choices);
+// travelling along d, toward light (or environment) `i` chosen with
+// probability `select`: the phase function replaces the BSDF and the
+// cosine, the shadow ray is attenuated by the medium's transmittance. Used
+// for the environment and directional lights; positional lights use the
+// equiangular estimate over the whole segment instead.
+vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis, inout uint rng) {
     LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
@@ -313,6 +316,46 @@ vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, bool mis, inout uint rng) {
     if (ls.pdf == 0.0) return contribution;  // delta light
     float w = mis ? powerHeuristic(ls.pdf * select, phase) : 1.0;
     return contribution * (w / ls.pdf);
+}
+
+// True for lights with a position (point, sphere, rect): the ones the
+// equiangular estimate aims at.
+bool positionalLight(uint i) { return i < frame.lightCount && lights[i].kind != LIGHT_DIRECTIONAL; }
+
+vec3 lightCentre(uint i) {
+    Light l = lights[i];
+    vec3 c = v3(l.position);
+    return l.kind == LIGHT_RECT ? c + 0.5 * (v3(l.edgeU) + v3(l.edgeV)) : c;
+}
+
+// Single scattering toward positional light `i` (chosen with probability
+// `select`) along the medium segment o + t d, t in [0, tEnd): a point by
+// equiangular sampling, a direction by the light's sampler, weighted by
+// multiple importance sampling against the path's own strategy (distance
+// sampling, density σ_t T(t), then the phase function); `mis` is false when
+// the path cannot continue (its last vertex). Returns the estimate before
+// the segment's throughput (it includes σ_s and both transmittances).
+vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float select, bool mis, inout uint rng) {
+    Equiangular e = equiangularSetup(o, d, tEnd, lightCentre(i));
+    float t = equiangularSample(e, rand(rng));
+    float pt = equiangularPdf(e, t);
+    if (!(t >= 0.0 && t < tEnd) || !(pt > 0.0)) return vec3(0.0);
+    vec3 x = o + t * d;
+    LightSample ls = sampleLight(lights[i], x, rand2(rng));
+    if (!ls.valid) return vec3(0.0);
+    float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
+    if (occluded(x, ls.wi, 0.0, ls.dist)) return vec3(0.0);
+    {
+        float tl;
+        uint first = firstLightHit(x, ls.wi, ls.dist, i, tl);
+        if (first != frame.lightCount) return vec3(0.0);
+    }
+    float tAlong = exp(-med.density * t);
+    vec3 f = (tAlong * transmittance(med, ls.dist) * med.density * phase) * v3(med.albedo) * ls.radiance;
+    if (ls.pdf == 0.0) return f / (select * pt);  // point light
+    float pA = select * pt * ls.pdf;
+    float w = mis ? powerHeuristic(pA, med.density * tAlong * phase) : 1.0;
+    return f * (w / pA);
 }
 
 // The media as local values (copied field by field: glslang mis-types a
@@ -371,6 +414,13 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
     vec3 throughput = vec3(1.0);
     float lastPdf = 0.0;      // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
     vec3 lastPoint = o;
+    // After a scattering event in a medium: the segment it was on (origin,
+    // end distance; direction), where on it, and the density σ_t T(t) of
+    // scattering there (0 after any other vertex).
+    vec4 scatterSegment = vec4(0.0);
+    vec3 scatterDir = vec3(0.0);
+    float scatterT = 0.0;
+    float scatterDensity = 0.0;
     uint choices = lightChoices();
     // Crossing an index-matched interface (relative index 1: the same medium
     // on both sides) is not a bounce; `step` bounds the loop all the same.
@@ -383,18 +433,33 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         // dielectric's interior, else the fog) may scatter or absorb it
         // before it reaches the surface or light at tl (distance sampling:
         // the event's weight is the albedo; passing through weighs 1).
-        Medium med = mediaCount > 0u ? materialMedium(media[mediaCount - 1u]) : fogMedium();
-        if (SHADING_MODE == SHADING_FULL && med.density > 0.0) {
+        Medium med = Medium(0.0, float[3](0.0, 0.0, 0.0), 0.0);
+        if (MEDIA_ENABLED != 0u) med = mediaCount > 0u ? materialMedium(media[mediaCount - 1u]) : fogMedium();
+        if (MEDIA_ENABLED != 0u && SHADING_MODE == SHADING_FULL && med.density > 0.0) {
+            // One light for this segment's single scattering: a positional
+            // light gets the equiangular estimate over the whole segment;
+            // the environment and directional lights get next-event
+            // estimation at the distance-sampled scattering point below.
+            uint choices = lightChoices();
+            uint li = choices > 0u ? min(uint(rand(rng) * float(choices)), choices - 1u) : frame.lightCount;
+            float select = 1.0 / float(max(choices, 1u));
+            bool last = bounce + 1u == frame.maxDepth;
+            bool positional = choices > 0u && positionalLight(li);
+            if (positional) radiance += throughput * equiangularNextEvent(med, o, d, tl, li, select, !last, rng);
             float ts = -log(1.0 - rand(rng)) / med.density;
             if (ts < tl) {
                 vec3 p = o + ts * d;
                 throughput *= v3(med.albedo);
-                bool last = bounce + 1u == frame.maxDepth;
-                radiance += throughput * mediumNextEvent(med, d, p, !last, rng);
+                if (choices > 0u && !positional) radiance += throughput * mediumNextEvent(med, d, p, li, select, !last, rng);
                 if (last) break;
                 vec3 wi = sampleHg(med.anisotropy, d, rand2(rng));
                 lastPdf = hgPdf(med.anisotropy, dot(d, wi));
                 lastPoint = p;
+                // For the weight of a positional light this direction may hit.
+                scatterSegment = vec4(o, tl);
+                scatterDir = d;
+                scatterT = ts;
+                scatterDensity = med.density * exp(-med.density * ts);
                 // Footprints: travel to p, then the phase lobe widens the
                 // angles (its angular spread taken as √(1 − |g|) rad, a
                 // heuristic: 1 rad for isotropic scattering).
@@ -417,7 +482,13 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
             // An emitter: a sphere or rect light, or the environment.
             vec3 le = which != frame.lightCount ? v3(lights[which].color) : environmentRadiance(d);
             float w = 1.0;
-            if (lastPdf > 0.0 && (which != frame.lightCount || environmentLit())) {
+            if (lastPdf > 0.0 && scatterDensity > 0.0 && which != frame.lightCount) {
+                // After a scattering event in a medium, a positional light
+                // competes with the equiangular estimate of that segment.
+                Equiangular e = equiangularSetup(scatterSegment.xyz, scatterDir, scatterSegment.w, lightCentre(which));
+                float pA = equiangularPdf(e, scatterT) * lightPdf(lights[which], lastPoint, d) / float(choices);
+                w = powerHeuristic(scatterDensity * lastPdf, pA);
+            } else if (lastPdf > 0.0 && (which != frame.lightCount || environmentLit())) {
                 w = powerHeuristic(lastPdf, lightOrEnvironmentPdf(which, lastPoint, d) / float(choices));
             }
             radiance += throughput * le * w;
@@ -540,6 +611,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         }
         throughput *= bs.weight;
         lastPdf = bs.pdf;
+        scatterDensity = 0.0;
         lastPoint = p;
         d = normalize(frameW * bs.wi);
         o = offsetOrigin(p, h.normal, d);

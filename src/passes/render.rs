@@ -121,7 +121,7 @@ pub fn render(
         &shaders::render(),
         &kinds,
         std::mem::size_of::<RenderPush>() as u32,
-        &[variant.intersect, variant.shading, variant.filter],
+        &[variant.intersect, variant.shading, variant.filter, u32::from(scene.has_media())],
     )?;
     let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
     pipeline.bind(&[

@@ -2826,6 +2826,36 @@ mod tests {
     }
 
     #[test]
+    fn fog_and_dielectric_media() {
+        // Top-level keys come before the first [table].
+        let with_fog = |fog: &str| parse_scene(&format!("{fog}\n{CAMERA}"), "t.toml");
+        let s = with_fog("fog = { density = 0.2, albedo = [0.9, 0.8, 0.7], anisotropy = 0.3 }").unwrap();
+        let fog = s.fog.unwrap();
+        assert_eq!((fog.density, fog.albedo, fog.anisotropy), (0.2, Vec3::new(0.9, 0.8, 0.7), 0.3));
+        // Defaults: no absorption, isotropic.
+        let fog = with_fog("fog = { density = 1 }").unwrap().fog.unwrap();
+        assert_eq!((fog.albedo, fog.anisotropy), (Vec3::ONE, 0.0));
+        assert!(parse("").fog.is_none());
+        let m =
+            one_material("type = \"dielectric\"\nior = 1.33\nmedium = { density = 0.5, albedo = [0.4, 0.4, 0.4] }\n");
+        assert_eq!(m.medium.unwrap().albedo, Vec3::splat(0.4));
+
+        let err = |fog: &str| with_fog(fog).unwrap_err().to_string();
+        let e = err("fog = { density = -1 }");
+        assert!(e.contains("fog.density: must not be negative (got -1)"), "{e}");
+        let e = err("fog = { density = 1, anisotropy = 1 }");
+        assert!(e.contains("fog.anisotropy: must be between -0.99 and 0.99 (got 1)"), "{e}");
+        let e = err("fog = { density = 1, colour = [1, 1, 1] }");
+        assert!(e.contains("fog.colour: unknown field"), "{e}");
+        let e = err("fog = { albedo = [1, 1, 1] }");
+        assert!(e.contains("fog.density: the required key `density` is missing"), "{e}");
+        let e = parse_scene(&format!("{CAMERA}[[materials]]\nname = \"m\"\nmedium = {{ density = 1 }}\n"), "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("materials[0].medium") && e.contains("dielectric"), "{e}");
+    }
+
+    #[test]
     fn error_location_counts_characters() {
         let e = parse_scene("# é\n[camera]\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\nfov = 200 # é\n", "x.toml")
             .unwrap_err();

@@ -273,6 +273,15 @@ pub struct Scene {
     pub fog: Option<Medium>,
 }
 
+impl Scene {
+    /// True when some medium (the fog, or a dielectric's interior) has a
+    /// positive density: the render shader's media code is compiled out
+    /// otherwise.
+    pub fn has_media(&self) -> bool {
+        self.fog.iter().chain(self.materials.iter().filter_map(|m| m.medium.as_ref())).any(|m| m.density > 0.0)
+    }
+}
+
 /// A lat-long environment map: the radiance arriving from infinity, what
 /// rays that hit nothing see, importance-sampled as a light
 /// (`sampling::envmap` documents the mapping and the sampling).
