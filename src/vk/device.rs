@@ -68,6 +68,7 @@ fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String>
         let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
         let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12).push_next(&mut fas).push_next(&mut frq);
         unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+        let float64 = f2.features.shader_float64;
         if f12.buffer_device_address == 0 {
             missing.push("bufferDeviceAddress".into());
         }
@@ -82,6 +83,10 @@ fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String>
         }
         if frq.ray_query == 0 {
             missing.push("rayQuery".into());
+        }
+        // The intersection re-bases rays near each object in f64.
+        if float64 == 0 {
+            missing.push("shaderFloat64".into());
         }
     }
     let has_compute = unsafe { instance.get_physical_device_queue_family_properties(pd) }
@@ -148,7 +153,7 @@ impl Device {
         let mut supported = vk::PhysicalDeviceFeatures2::default().push_next(&mut supported12);
         unsafe { raw_instance.get_physical_device_features2(physical, &mut supported) };
         let base_features = vk::PhysicalDeviceFeatures::default()
-            .shader_float64(supported.features.shader_float64 == vk::TRUE)
+            .shader_float64(true)
             .shader_int64(supported.features.shader_int64 == vk::TRUE);
 
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
