@@ -290,7 +290,13 @@ fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> Result<quadr
     use quadray::shader_interface::{INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, SHADING_FULL, SHADING_NONE};
     let device = &ctx.device;
     let mut cmds = quadray::vk::Commands::new(device)?;
-    let gpu = GpuScene::new(device, &mut cmds, scene, &quadray::geometry::CellParams::default())?;
+    let gpu = GpuScene::with_origin(
+        device,
+        &mut cmds,
+        scene,
+        &quadray::geometry::CellParams::default(),
+        scene.camera.position,
+    )?;
     let im = &scene.image;
     let variants = [
         ("full render", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter }),

@@ -242,6 +242,24 @@ pub struct GpuLight {
     pub edge_v: [f32; 3],
 }
 
+impl GpuLight {
+    /// The light with its position relative to `origin` (computed in f64;
+    /// directional lights have none).
+    pub fn relative_to(l: &Light, origin: DVec3) -> Self {
+        let mut g = Self::from(l);
+        if !matches!(l, Light::Directional { .. }) {
+            let p = match l {
+                Light::Point { position, .. } => *position,
+                Light::Sphere { centre, .. } => *centre,
+                Light::Rect { corner, .. } => *corner,
+                Light::Directional { .. } => DVec3::ZERO,
+            };
+            g.position = (p - origin).as_vec3().to_array();
+        }
+        g
+    }
+}
+
 impl From<&Light> for GpuLight {
     fn from(l: &Light) -> Self {
         let f = |v: DVec3| v.as_vec3().to_array();

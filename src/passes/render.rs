@@ -69,7 +69,8 @@ pub fn render(
     let pixels = width as u64 * height as u64;
     let [eye, forward, right, up] = camera_basis(scene, width, height);
     let frame = GpuFrame {
-        eye: eye.as_vec3().to_array(),
+        // Relative to the GPU frame's origin (the camera, for renders).
+        eye: (eye - gpu.origin).as_vec3().to_array(),
         forward: forward.as_vec3().to_array(),
         right: right.as_vec3().to_array(),
         up: up.as_vec3().to_array(),

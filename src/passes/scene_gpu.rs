@@ -63,6 +63,8 @@ pub struct GpuScene {
     pub environment: Option<(u32, u32, u32, f32)>,
     /// Sizes.
     pub stats: GeometryStats,
+    /// The world point at the GPU frame's origin ([`Self::with_origin`]).
+    pub origin: DVec3,
 }
 
 /// Uploads a texture with its mip chain as an RGBA32F image.
@@ -126,6 +128,21 @@ impl GpuScene {
         scene: &Scene,
         params: &CellParams,
     ) -> Result<Self, RenderError> {
+        Self::with_origin(device, cmds, scene, params, DVec3::ZERO)
+    }
+
+    /// [`Self::new`] with the GPU's world frame centred on `origin`: object
+    /// transforms and light positions are made relative to it in f64 before
+    /// they are rounded to f32, so that geometry near `origin` (the camera,
+    /// for renders) keeps f32's full precision however far it lies from the
+    /// scene's origin. Rays given to the GPU must be relative to it too.
+    pub fn with_origin(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        scene: &Scene,
+        params: &CellParams,
+        origin: DVec3,
+    ) -> Result<Self, RenderError> {
         let mut objects = Vec::new();
         let mut cells: Vec<GpuCell> = Vec::new();
         let mut perturbations: Vec<GpuPerturbation> = Vec::new();
@@ -153,7 +170,8 @@ impl GpuScene {
                 lists.extend(c.perturbations.iter().map(|&i| first_perturbation + i));
             }
             blases.push(AccelerationStructure::bottom_level_aabbs(device, cmds, &aabbs)?);
-            placements.push((blases.len() - 1, object.transform, index as u32));
+            let relative = DAffine3::from_translation(-origin) * object.transform;
+            placements.push((blases.len() - 1, relative, index as u32));
         }
 
         let instances: Vec<AsInstance<'_>> = placements
@@ -184,7 +202,7 @@ impl GpuScene {
             }
             None => (None, vec![0.0f32]),
         };
-        let lights: Vec<GpuLight> = scene.lights.iter().map(GpuLight::from).collect();
+        let lights: Vec<GpuLight> = scene.lights.iter().map(|l| GpuLight::relative_to(l, origin)).collect();
 
         let stats = GeometryStats {
             perturbations: perturbations.len(),
@@ -210,6 +228,7 @@ impl GpuScene {
             tlas,
             _blases: blases,
             stats,
+            origin,
         })
     }
 
