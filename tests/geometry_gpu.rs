@@ -205,16 +205,6 @@ fn compare(
     }
 }
 
-fn random_unit(rng: &mut Pcg64) -> DVec3 {
-    loop {
-        let v = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
-        let l = v.length_squared();
-        if l > 1e-6 && l <= 1.0 {
-            return v / l.sqrt();
-        }
-    }
-}
-
 fn gpu_ray(o: DVec3, d: DVec3, tmin: f64) -> GpuRay {
     GpuRay { origin: o.as_vec3().to_array(), tmin: tmin as f32, dir: d.as_vec3().to_array(), tmax: 1e30 }
 }
@@ -251,20 +241,20 @@ fn gpu_hits_match_the_f64_reference() {
     let mut rng = Pcg64::seed_from_u64(7);
 
     // Categories of rays.
-    let random = aimed_rays(&mut rng, &boxes, 100_000, |r| centre + 12.0 * random_unit(r));
-    let far = aimed_rays(&mut rng, &boxes, 5_000, |r| centre + r.gen_range(1e3..1e4) * random_unit(r));
+    let random = aimed_rays(&mut rng, &boxes, 100_000, |r| centre + 12.0 * common::random_unit(r));
+    let far = aimed_rays(&mut rng, &boxes, 5_000, |r| centre + r.gen_range(1e3..1e4) * common::random_unit(r));
     // Rays leaving a surface point into the outer hemisphere, and grazing rays
     // through points just off a surface, tangent to it.
     let mut on_surface = Vec::new();
     let mut grazing = Vec::new();
     while on_surface.len() < 5_000 {
-        let ray = aimed_rays(&mut rng, &boxes, 1, |r| centre + 12.0 * random_unit(r))[0];
+        let ray = aimed_rays(&mut rng, &boxes, 1, |r| centre + 12.0 * common::random_unit(r))[0];
         let o = DVec3::from_array(ray.origin.map(|v| v as f64));
         let d = DVec3::from_array(ray.dir.map(|v| v as f64));
         let Some(h) = trace_reference(&placed, o, d, 0.0) else { continue };
         let p = o + h.t * d;
         let n = if h.normal.dot(d) > 0.0 { -h.normal } else { h.normal };
-        let mut dir = random_unit(&mut rng);
+        let mut dir = common::random_unit(&mut rng);
         if dir.dot(n) < 0.0 {
             dir = -dir;
         }

@@ -80,7 +80,7 @@ fn scales_and_offsets_against_the_f64_reference() {
                     GpuScene::with_origin(&ctx.device, &mut cmds, &scene, &CellParams::default(), origin).unwrap();
                 let rays: Vec<GpuRay> = (0..RAYS)
                     .map(|_| {
-                        let o = centre + 6.0 * s * random_unit(&mut rng);
+                        let o = centre + 6.0 * s * common::random_unit(&mut rng);
                         let target = centre + 1.3 * s * DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.65 * s;
                         let d = (target - o).normalize();
                         let o = o - origin;
@@ -145,14 +145,4 @@ fn scales_and_offsets_against_the_f64_reference() {
     drop(ctx);
     common::assert_no_validation_errors(&counters);
     assert!(violations.is_empty(), "beyond the bounds: {violations:?}");
-}
-
-fn random_unit(rng: &mut Pcg64) -> DVec3 {
-    loop {
-        let v = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
-        let l = v.length_squared();
-        if l > 1e-6 && l <= 1.0 {
-            return v / l.sqrt();
-        }
-    }
 }

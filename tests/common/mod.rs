@@ -22,6 +22,18 @@ pub fn assert_no_validation_errors(counters: &Arc<ValidationCounters>) {
     println!("validation layer: 0 errors, {} warnings", counters.warnings());
 }
 
+/// A uniformly random unit vector (rejection from the unit ball).
+pub fn random_unit(rng: &mut rand_pcg::Pcg64) -> DVec3 {
+    use rand::Rng;
+    loop {
+        let v = DVec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+        let l = v.length_squared();
+        if l > 1e-6 && l <= 1.0 {
+            return v / l.sqrt();
+        }
+    }
+}
+
 /// `n` bumps spread over a sphere of radius `on` (see `geometry::scatter`).
 pub fn spread_bumps(n: usize, on: f64, r: f64, f: f64, alternate: bool) -> Vec<Perturbation> {
     quadray::geometry::scatter::spread_bumps(n, DVec3::splat(on), r, f, alternate)
