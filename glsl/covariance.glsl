@@ -68,16 +68,21 @@ void covRotate(inout PathCovariance c, vec3 e1n, vec3 e2n) {
     c.e2 = e2n;
 }
 
-// Meets a surface of normal n: turns the path's frame so that e1 is the
-// component of t1 (the ray's direction projected on the surface) across the
-// ray and e2 = t2 = n × t1, and returns the spatial covariance on the
-// surface in the tangent basis (t1, t2): an offset x along e1 covers
-// x / |cos θ| along t1 (bounded: MIN_FOOTPRINT_COS). `inv` returns that 1 / |cos θ|.
-mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, out vec3 t1, out vec3 t2, out float inv) {
+// The tangent basis of a hit for footprints: t1 along the ray's projection
+// on the surface, t2 = n × t1.
+void footprintBasis(vec3 d, vec3 n, out vec3 t1, out vec3 t2) {
     vec3 along = d - n * dot(n, d);
     float al = length(along);
     t1 = al > 1e-6 ? along / al : frameAround(n)[0];
     t2 = cross(n, t1);
+}
+
+// Meets a surface of normal n, with the basis (t1, t2) of footprintBasis:
+// turns the path's frame so that e1 is the component of t1 across the ray
+// and e2 = t2, and returns the spatial covariance on the surface in the
+// tangent basis (t1, t2): an offset x along e1 covers x / |cos θ| along t1
+// (bounded: MIN_FOOTPRINT_COS). `inv` returns that 1 / |cos θ|.
+mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, vec3 t1, vec3 t2, out float inv) {
     vec3 e1n = t1 - d * dot(d, t1);
     float el = length(e1n);
     e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, d));

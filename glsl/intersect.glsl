@@ -251,6 +251,7 @@ struct SceneHit {
     uint object;
     uint cell;           // index into cells[] of the hit's cell
     vec3 normal;         // world space, outward (-∇F'), unit length
+    float gradientLength;  // |∇F'| in world units (0 on a miss)
     vec3 objectPoint;    // the hit in the object's frame
     mat3 worldToObject;  // linear part of the world-to-object transform
 };
@@ -319,6 +320,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
     h.object = NO_HIT;
     h.cell = 0u;
     h.normal = vec3(0.0);
+    h.gradientLength = 0.0;
     h.objectPoint = vec3(0.0);
     h.worldToObject = mat3(1.0);
     if (rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionGeneratedEXT) {
@@ -332,6 +334,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
         vec3 n = -(transpose(h.worldToObject) * g);
         float len = length(n);
         h.normal = len > 0.0 ? n / len : -d;
+        h.gradientLength = len;
     }
     return h;
 }
@@ -342,8 +345,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
 // world-to-object map (F'(M p + c) in world space). Exact: the analytic
 // Hessian of F'. Twin: FunctionalObject::curvatures.
 mat2 shapeOperator(SceneHit h, vec3 t1, vec3 t2) {
-    vec3 g = transpose(h.worldToObject) * cellGradient(h.object, h.cell, h.objectPoint);
-    float len = length(g);
+    float len = h.gradientLength;
     if (len == 0.0) return mat2(0.0);
     mat3 hess = cellHessian(h.object, h.cell, h.objectPoint);
     vec3 a = h.worldToObject * t1, b = h.worldToObject * t2;

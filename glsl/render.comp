@@ -95,15 +95,6 @@ vec3 heightAndSlopes(uint index, vec2 uv) {
     return vec3(h, dhdu, dhdv);
 }
 
-// The tangent basis of a hit for footprints: t1 along the ray's projection
-// on the surface, t2 = n × t1.
-void footprintBasis(vec3 d, vec3 n, out vec3 t1, out vec3 t2) {
-    vec3 along = d - n * dot(n, d);
-    float al = length(along);
-    t1 = al > 1e-6 ? along / al : frameAround(n)[0];
-    t2 = cross(n, t1);
-}
-
 // A ray cone's footprint on the surface, in the basis (t1, t2): σ across the
 // ray, σ / |cos θ| along t1 (stretch bounded: MIN_FOOTPRINT_COS).
 mat2 coneFootprint(vec3 d, vec3 n, float sigma) {
@@ -256,6 +247,16 @@ uint firstLightHit(vec3 o, vec3 d, float tmax, uint except, out float tHit) {
     return which;
 }
 
+// True when nothing blocks the shadow ray from `origin` along wi over
+// `dist` toward light `i`: no geometry, and no other sphere or rect light in
+// front (lights are not in the acceleration structure, so they may hide
+// each other).
+bool lightVisible(vec3 origin, vec3 wi, float dist, uint i) {
+    if (occluded(origin, wi, 0.0, dist)) return false;
+    float tl;
+    return firstLightHit(origin, wi, dist, i, tl) == frame.lightCount;
+}
+
 // Number of light-sampling choices: the lights, plus the environment.
 uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
 
@@ -277,14 +278,7 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, Medium med, 
     // part of the offset along the ray, so that the ray ends at the light.
     vec3 origin = offsetOrigin(p, ng, ls.wi);
     float dist = ls.dist - dot(origin - p, ls.wi);
-    if (occluded(origin, ls.wi, 0.0, dist)) return vec3(0.0);
-    // Area lights may hide each other: another sphere or rect light in front
-    // blocks this one (lights are not in the acceleration structure).
-    {
-        float tl;
-        uint first = firstLightHit(origin, ls.wi, dist, i, tl);
-        if (first != frame.lightCount) return vec3(0.0);
-    }
+    if (!lightVisible(origin, ls.wi, dist, i)) return vec3(0.0);
     // The medium around the vertex attenuates the shadow ray (a shadow ray
     // that would cross into another medium meets its boundary and is
     // occluded above).
@@ -306,12 +300,7 @@ vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis,
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
     float tr = transmittance(med, ls.dist);
-    if (tr == 0.0 || occluded(p, ls.wi, 0.0, ls.dist)) return vec3(0.0);
-    {
-        float tl;
-        uint first = firstLightHit(p, ls.wi, ls.dist, i, tl);
-        if (first != frame.lightCount) return vec3(0.0);
-    }
+    if (tr == 0.0 || !lightVisible(p, ls.wi, ls.dist, i)) return vec3(0.0);
     vec3 contribution = phase * tr * ls.radiance / select;
     if (ls.pdf == 0.0) return contribution;  // delta light
     float w = mis ? powerHeuristic(ls.pdf * select, phase) : 1.0;
@@ -344,12 +333,7 @@ vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float 
     LightSample ls = sampleLight(lights[i], x, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
-    if (occluded(x, ls.wi, 0.0, ls.dist)) return vec3(0.0);
-    {
-        float tl;
-        uint first = firstLightHit(x, ls.wi, ls.dist, i, tl);
-        if (first != frame.lightCount) return vec3(0.0);
-    }
+    if (!lightVisible(x, ls.wi, ls.dist, i)) return vec3(0.0);
     float tAlong = exp(-med.density * t);
     vec3 f = (tAlong * transmittance(med, ls.dist) * med.density * phase) * v3(med.albedo) * ls.radiance;
     if (ls.pdf == 0.0) return f / (select * pt);  // point light
@@ -498,7 +482,9 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         vec3 ns;
         float width = coneWidth + coneSpread * h.t;
         mat2 footprint;
+        // The footprint's tangent basis at this hit, shared by every filter step.
         vec3 ct1, ct2;
+        footprintBasis(d, h.normal, ct1, ct2);
         float covInv = 1.0;
         if (FILTER_MODE == FILTER_COVARIANCE) {
             covTravel(cov, h.t);
@@ -574,9 +560,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
             } else if (mat.kind == MATERIAL_DIFFUSE) {
                 gain = vec2(1.0);
             }
-            vec3 t1, t2;
-            footprintBasis(d, h.normal, t1, t2);
-            mat2 shape = shapeOperator(h, t1, t2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
+            mat2 shape = shapeOperator(h, ct1, ct2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
             if (FILTER_MODE == FILTER_COVARIANCE) {
                 // Angular standard deviation of the lobe: about √2 α for GGX
                 // reflection, about 0.6 rad for Lambert, 0 for delta lobes.
