@@ -102,7 +102,7 @@ fn main() {
         let scene = sphere_scene(n);
         let gpu = GpuScene::new(&device, &mut cmds, &scene, &params).unwrap();
         let timed = |mode: u32, cmds: &mut Commands| {
-            let probe = ProbePass::new(&device, &gpu, &rays, mode).unwrap();
+            let probe = ProbePass::new(&device, &gpu, &rays, mode, false).unwrap();
             let (hits, _) = probe.run(cmds).unwrap(); // discarded: the shader compiles here
             let mut times: Vec<f64> = (0..RUNS).map(|_| probe.run(cmds).unwrap().1 * 1e-6).collect();
             times.sort_by(f64::total_cmp);

@@ -24,6 +24,10 @@ struct Hit {
 layout(set = 0, binding = BINDING_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
 layout(set = 0, binding = BINDING_HITS, scalar) writeonly buffer Hits { Hit hits[]; };
 
+// Specialisation constant: 1 to write the curvatures (the geometry tests),
+// 0 to skip their Hessian (the ray benchmark times intersection alone).
+layout(constant_id = 1) const uint PROBE_CURVATURE = 1u;
+
 layout(push_constant, scalar) uniform Push {
     uint first;
     uint count;
@@ -42,7 +46,7 @@ void main() {
     outHit.object = h.object;
     outHit.meanCurvature = 0.0;
     outHit.gaussCurvature = 0.0;
-    if (h.object != NO_HIT) {
+    if (PROBE_CURVATURE != 0u && h.object != NO_HIT) {
         mat3 f = frameAround(h.normal);
         mat2 s = shapeOperator(h, f[0], f[1]);
         outHit.meanCurvature = 0.5 * (s[0][0] + s[1][1]);

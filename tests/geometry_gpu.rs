@@ -307,7 +307,7 @@ fn gpu_hits_match_the_f64_reference() {
         ("on-surface", &on_surface, ON_SURFACE_MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES, MAX_CURVATURE_ERROR),
         ("grazing", &grazing, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES, MAX_CURVATURE_ERROR),
     ] {
-        let probe = ProbePass::new(&ctx.device, &gpu_scene, rays, INTERSECT_FULL).unwrap();
+        let probe = ProbePass::new(&ctx.device, &gpu_scene, rays, INTERSECT_FULL, true).unwrap();
         let (hits, _) = probe.run(&mut cmds).unwrap();
         let refs: Vec<Option<RefHit>> = rays
             .iter()

@@ -88,7 +88,7 @@ fn scales_and_offsets_against_the_f64_reference() {
                     })
                     .collect();
                 let (hits, _) =
-                    ProbePass::new(&ctx.device, &gpu, &rays, INTERSECT_FULL).unwrap().run(&mut cmds).unwrap();
+                    ProbePass::new(&ctx.device, &gpu, &rays, INTERSECT_FULL, false).unwrap().run(&mut cmds).unwrap();
                 drop(gpu);
 
                 let epsilon = 6e-8 * ((centre - origin).length() + 6.0 * s) / s;

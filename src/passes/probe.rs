@@ -23,8 +23,15 @@ pub struct ProbePass {
 
 impl ProbePass {
     /// Uploads `rays` and binds them with the scene; `mode` is one of the
-    /// `INTERSECT_*` constants (`INTERSECT_FULL` for the real intersection).
-    pub fn new(device: &Arc<Device>, scene: &GpuScene, rays: &[GpuRay], mode: u32) -> Result<Self, RenderError> {
+    /// `INTERSECT_*` constants (`INTERSECT_FULL` for the real intersection);
+    /// `curvature` asks for the hits' curvatures (zero otherwise).
+    pub fn new(
+        device: &Arc<Device>,
+        scene: &GpuScene,
+        rays: &[GpuRay],
+        mode: u32,
+        curvature: bool,
+    ) -> Result<Self, RenderError> {
         let kinds = [
             BindingKind::AccelerationStructure,
             BindingKind::StorageBuffer,
@@ -34,8 +41,13 @@ impl ProbePass {
             BindingKind::StorageBuffer,
             BindingKind::StorageBuffer,
         ];
-        let pipeline =
-            ComputePipeline::new(device, &shaders::probe(), &kinds, std::mem::size_of::<ProbePush>() as u32, &[mode])?;
+        let pipeline = ComputePipeline::new(
+            device,
+            &shaders::probe(),
+            &kinds,
+            std::mem::size_of::<ProbePush>() as u32,
+            &[mode, u32::from(curvature)],
+        )?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::new(
             device,
