@@ -243,20 +243,17 @@ pub struct GpuLight {
 }
 
 impl GpuLight {
-    /// The light with its position relative to `origin` (computed in f64;
-    /// directional lights have none).
+    /// The light with its position relative to `origin` (subtracted in f64,
+    /// before the rounding to f32; directional lights have none).
     pub fn relative_to(l: &Light, origin: DVec3) -> Self {
-        let mut g = Self::from(l);
-        if !matches!(l, Light::Directional { .. }) {
-            let p = match l {
-                Light::Point { position, .. } => *position,
-                Light::Sphere { centre, .. } => *centre,
-                Light::Rect { corner, .. } => *corner,
-                Light::Directional { .. } => DVec3::ZERO,
-            };
-            g.position = (p - origin).as_vec3().to_array();
+        let mut l = l.clone();
+        match &mut l {
+            Light::Point { position: p, .. } | Light::Sphere { centre: p, .. } | Light::Rect { corner: p, .. } => {
+                *p -= origin
+            }
+            Light::Directional { .. } => {}
         }
-        g
+        Self::from(&l)
     }
 }
 
