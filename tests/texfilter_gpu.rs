@@ -41,6 +41,21 @@ const EWA_ANISOTROPIC_TOLERANCE: f64 = 0.08;
 const EWA_SUBTEXEL_TOLERANCE: f64 = 0.3;
 /// Footprints of many cells: the average is ½.
 const EWA_WIDE_TOLERANCE: f64 = 0.005;
+/// The footprint classes of the EWA test: (minor σ in texels, anisotropy).
+const EWA_CLASSES: [(f64, f64); 10] = [
+    (0.1, 1.0),
+    (0.4, 1.0),
+    (1.0, 1.0),
+    (2.0, 1.0),
+    (4.0, 1.0),
+    (8.0, 1.0),
+    (16.0, 1.0),
+    (2.0, 4.0),
+    (4.0, 8.0),
+    (WIDE_SIGMA, 1.0),
+];
+/// σ (texels) of the wide class: many checker cells under the footprint.
+const WIDE_SIGMA: f64 = 200.0;
 /// LEAN at the coarsest level: relative error of the widened α.
 const LEAN_ALPHA_TOLERANCE: f64 = 0.01;
 
@@ -100,12 +115,10 @@ fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
         MaterialMaps { albedo: Some(0), ..Default::default() },
     );
     let texel = 1.0 / SIZE as f64;
-    // (minor σ in texels, anisotropy) classes; random centres and angles.
+    // Random centres and angles in each class but the wide one.
     let mut rng = Pcg64::seed_from_u64(11);
     let mut cases = Vec::new();
-    for &(sigma, aniso) in
-        &[(0.1, 1.0), (0.4, 1.0), (1.0, 1.0), (2.0, 1.0), (4.0, 1.0), (8.0, 1.0), (16.0, 1.0), (2.0, 4.0), (4.0, 8.0)]
-    {
+    for &(sigma, aniso) in EWA_CLASSES.iter().filter(|&&(sigma, _)| sigma < WIDE_SIGMA) {
         for _ in 0..24 {
             let uv = DVec2::new(rng.gen(), rng.gen());
             let angle: f64 = rng.gen_range(0.0..std::f64::consts::PI);
@@ -118,7 +131,8 @@ fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
     // Wide footprints: many cells under the 1σ ellipse.
     for _ in 0..24 {
         let uv = DVec2::new(rng.gen(), rng.gen());
-        cases.push((200.0, 1.0, uv, DVec2::new(200.0 * texel, 0.0), DVec2::new(0.0, 200.0 * texel)));
+        let a = WIDE_SIGMA * texel;
+        cases.push((WIDE_SIGMA, 1.0, uv, DVec2::new(a, 0.0), DVec2::new(0.0, a)));
     }
     let queries: Vec<_> = cases.iter().map(|&(_, _, uv, a1, a2)| query(0, uv, a1, a2, 0.0)).collect();
 
@@ -151,7 +165,7 @@ fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
             sum += err;
             n += 1;
         }
-        let bound = if sigma >= 100.0 {
+        let bound = if sigma >= WIDE_SIGMA {
             EWA_WIDE_TOLERANCE
         } else if sigma < 1.0 {
             EWA_SUBTEXEL_TOLERANCE
@@ -165,18 +179,7 @@ fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
             failures.push(format!("σ {sigma} texels, anisotropy {aniso}: {max:.4} > {bound}"));
         }
     };
-    for &(sigma, aniso) in &[
-        (0.1, 1.0),
-        (0.4, 1.0),
-        (1.0, 1.0),
-        (2.0, 1.0),
-        (4.0, 1.0),
-        (8.0, 1.0),
-        (16.0, 1.0),
-        (2.0, 4.0),
-        (4.0, 8.0),
-        (200.0, 1.0),
-    ] {
+    for &(sigma, aniso) in &EWA_CLASSES {
         class(sigma, aniso);
     }
     assert!(failures.is_empty(), "EWA beyond its bounds: {failures:?}");
