@@ -20,29 +20,15 @@ mod common;
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{FunctionalObject, Quadric};
 use quadray::passes::RenderOutput;
-use quadray::scene::{Material, Scene};
+use quadray::scene::Material;
 
 const MEAN_TOLERANCE: f64 = 0.005;
 const PIXEL_TOLERANCE: f64 = 0.1;
 const BLOCK_TOLERANCE: f64 = 0.03;
 
-fn render(scene: &Scene) -> RenderOutput {
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let out = quadray::render_scene(&ctx, scene, &mut |_, _| {}).unwrap();
-    drop(ctx);
-    common::assert_no_validation_errors(&counters);
-    out
-}
-
 /// Checks every pixel against `expected`; prints the figures.
 fn check_uniform(name: &str, out: &RenderOutput, expected: f64) {
-    let values: Vec<f64> = out.radiance.iter().flat_map(|p| p.map(|c| c as f64)).collect();
-    assert!(values.iter().all(|v| v.is_finite()), "{name}: non-finite pixel");
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let sigma = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-    let worst = values.iter().map(|v| (v - expected).abs()).fold(0.0, f64::max);
+    let common::UniformStats { mean, standard_error, worst } = common::UniformStats::of(out, expected);
     let (w, h) = (out.width as usize, out.height as usize);
     let mut worst_block: f64 = 0.0;
     for by in (0..h - h % 4).step_by(4) {
@@ -60,8 +46,7 @@ fn check_uniform(name: &str, out: &RenderOutput, expected: f64) {
         "{name}: {w}x{h} at {} spp: mean {mean:.5} (expected {expected}, bound ±{MEAN_TOLERANCE}, standard error \
          {:.5}); worst pixel error {worst:.4} (bound {PIXEL_TOLERANCE}); worst 4x4 block error {worst_block:.4} \
          (bound {BLOCK_TOLERANCE})",
-        out.spp,
-        sigma / n.sqrt(),
+        out.spp, standard_error,
     );
     assert!((mean - expected).abs() <= MEAN_TOLERANCE, "{name}: mean {mean}");
     assert!(worst <= PIXEL_TOLERANCE, "{name}: worst pixel error {worst}");
@@ -79,7 +64,7 @@ fn white_furnace_reflects_the_environment_exactly() {
     scene.image.spp = 512;
     scene.image.max_depth = 64;
     scene.camera.position = DVec3::new(0.0, 4.0, 9.0);
-    check_uniform("white furnace", &render(&scene), 1.0);
+    check_uniform("white furnace", &common::render_validated(&scene), 1.0);
 }
 
 #[test]
@@ -101,7 +86,7 @@ fn closed_furnace_converges_to_emission_over_one_minus_albedo() {
     scene.image.height = 24;
     scene.image.spp = 512;
     scene.image.max_depth = 64;
-    check_uniform("closed furnace", &render(&scene), 1.0);
+    check_uniform("closed furnace", &common::render_validated(&scene), 1.0);
 }
 
 /// Directional albedo E(cos θo) of a GGX conductor with F = 1 (single
@@ -151,7 +136,7 @@ fn ggx_conductor_loses_only_the_single_scattering_energy() {
         scene.image.height = 40;
         scene.image.spp = 512;
         scene.image.max_depth = 8;
-        let out = render(&scene);
+        let out = common::render_validated(&scene);
         let table: Vec<f64> = (0..=40).map(|k| ggx_albedo(roughness as f64, (k as f64 / 40.0).max(1e-3))).collect();
         let albedo_at = |c: f64| {
             let x = c.clamp(0.0, 1.0) * 40.0;

@@ -14,7 +14,7 @@ mod common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{FunctionalObject, Quadric};
-use quadray::scene::{Light, Material, Medium, Scene};
+use quadray::scene::{Light, Material, Medium};
 
 /// Image mean within this of the expected mean.
 const MEAN_TOLERANCE: f64 = 0.005;
@@ -50,16 +50,6 @@ fn ball(radius: f64, at: DVec3) -> quadray::scene::SceneObject {
     common::object("ball", shape, DAffine3::from_translation(at))
 }
 
-fn render(scene: &Scene) -> quadray::passes::RenderOutput {
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let out = quadray::render_scene(&ctx, scene, &mut |_, _| {}).unwrap();
-    drop(ctx);
-    common::assert_no_validation_errors(&counters);
-    assert!(out.radiance.iter().flatten().all(|v| v.is_finite()), "non-finite pixel");
-    out
-}
-
 #[test]
 fn absorbing_fog_transmits_beer_lambert() {
     let h = 2.0;
@@ -73,7 +63,7 @@ fn absorbing_fog_transmits_beer_lambert() {
     scene.image.width = 48;
     scene.image.height = 36;
     scene.image.spp = 256;
-    let out = render(&scene);
+    let out = common::render_validated(&scene);
 
     let (w, hgt) = (48usize, 36usize);
     let [eye, forward, right, up] = quadray::passes::scene_gpu::camera_basis(&scene, w as u32, hgt as u32);
@@ -118,16 +108,11 @@ fn scattering_fog_in_a_box_of_lights_is_a_furnace() {
         scene.image.height = 24;
         scene.image.spp = 256;
         scene.image.max_depth = 256;
-        let out = render(&scene);
-        let values: Vec<f64> = out.radiance.iter().flat_map(|p| p.map(|c| c as f64)).collect();
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let sigma = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-        let worst = values.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
+        let out = common::render_validated(&scene);
+        let common::UniformStats { mean, standard_error, worst } = common::UniformStats::of(&out, 1.0);
         println!(
             "fog furnace (σ_t = {density}, g = {g}): mean {mean:.5} (expected 1, bound ±{MEAN_TOLERANCE}, standard \
-             error {:.5}); worst pixel {worst:.4} (bound {PIXEL_TOLERANCE})",
-            sigma / n.sqrt()
+             error {standard_error:.5}); worst pixel {worst:.4} (bound {PIXEL_TOLERANCE})"
         );
         assert!((mean - 1.0).abs() <= MEAN_TOLERANCE, "mean {mean}");
         assert!(worst <= PIXEL_TOLERANCE, "worst {worst}");

@@ -22,6 +22,40 @@ pub fn assert_no_validation_errors(counters: &Arc<ValidationCounters>) {
     println!("validation layer: 0 errors, {} warnings", counters.warnings());
 }
 
+/// Renders `scene` on a fresh validated context; fails on any validation
+/// error (counted after the device is gone) and on any NaN or Inf pixel.
+pub fn render_validated(scene: &Scene) -> quadray::passes::RenderOutput {
+    let ctx = context();
+    let counters = ctx.counters();
+    let out = quadray::render_scene(&ctx, scene, &mut |_, _| {}).unwrap();
+    drop(ctx);
+    assert_no_validation_errors(&counters);
+    assert!(out.radiance.iter().flatten().all(|v| v.is_finite()), "non-finite pixel");
+    out
+}
+
+/// Statistics of every channel of every pixel against a value every pixel
+/// should have (furnace tests).
+pub struct UniformStats {
+    /// Mean over pixels and channels.
+    pub mean: f64,
+    /// Standard error of that mean (sample standard deviation / √n).
+    pub standard_error: f64,
+    /// Largest |value − expected|.
+    pub worst: f64,
+}
+
+impl UniformStats {
+    pub fn of(out: &quadray::passes::RenderOutput, expected: f64) -> Self {
+        let values: Vec<f64> = out.radiance.iter().flat_map(|p| p.map(f64::from)).collect();
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let sigma = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let worst = values.iter().map(|v| (v - expected).abs()).fold(0.0, f64::max);
+        Self { mean, standard_error: sigma / n.sqrt(), worst }
+    }
+}
+
 /// A uniformly random unit vector (rejection from the unit ball).
 pub fn random_unit(rng: &mut rand_pcg::Pcg64) -> DVec3 {
     use rand::Rng;
