@@ -292,14 +292,20 @@ impl Bench<'_> {
         let right = (c.look_at - c.position).cross(c.up).normalize_or(DVec3::X);
         c.position += right * offset;
         c.look_at += right * offset;
-        let variant = RenderVariant { filter, shading: self.shading, ..Default::default() };
         let (w, h) = self.size;
+        let variant = self.variant(filter);
         Ok(render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, (w, h, spp), variant, &mut |_, _| {})?)
     }
 
-    /// A render with `filter` after an untimed warm-up of its shader variant.
+    /// The render shader variant of `filter` with the bench's shading.
+    fn variant(&self, filter: u32) -> RenderVariant {
+        RenderVariant { filter, shading: self.shading, ..Default::default() }
+    }
+
+    /// An untimed 8x8 render that makes lavapipe compile `filter`'s shader
+    /// variant (it does so at the first dispatch) before the timed renders.
     fn warm_up(&mut self, filter: u32) -> Result<(), BenchError> {
-        let variant = RenderVariant { filter, shading: self.shading, ..Default::default() };
+        let variant = self.variant(filter);
         render(&self.ctx.device, &mut self.cmds, &self.gpu, &self.scene, (8, 8, 1), variant, &mut |_, _| {})?;
         Ok(())
     }

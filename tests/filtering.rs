@@ -168,7 +168,8 @@ const MIRROR_REFERENCE_SPP: u32 = 1024;
 /// filtered ones must average. Shading variant SHADING_MIRRORED_ALBEDO (the
 /// albedo seen through mirrors, no lighting), so that the reference with
 /// many samples is the exact pixel average. Compared over the pixels whose
-/// four corners all see the ball.
+/// four corners all see the ball. With `QUADRAY_TEST_IMAGES=DIR` the
+/// reference and the three 1-spp renders are written to DIR as PNGs.
 #[test]
 fn footprints_through_a_curved_mirror_average_the_reflected_checker() {
     let floor = FunctionalObject {

@@ -123,7 +123,7 @@ mod tests {
     }
 
     #[test]
-    fn height_slopes_of_a_ramp_wave() {
+    fn height_slopes_of_a_sine_wave() {
         // h = sin(2π u): ∂h/∂u = 2π cos(2π u) per unit of u; the mean of its
         // square over a period is 2π², which the 1x1 level holds.
         let n = 256usize;
