@@ -46,6 +46,8 @@ fn sphere_scene(n: usize) -> Scene {
         textures: vec![],
         environment: None,
         fog: None,
+        caustics: Default::default(),
+        volume: Default::default(),
     }
 }
 

@@ -256,6 +256,13 @@ struct SceneHit {
     mat3 worldToObject;  // linear part of the world-to-object transform
 };
 
+// Offset along the geometric normal, to the side of `dir`, that keeps a
+// secondary ray off its own surface.
+vec3 offsetOrigin(vec3 p, vec3 n, vec3 dir) {
+    float scale = max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
+    return p + (dot(dir, n) >= 0.0 ? n : -n) * (2e-4 * scale);
+}
+
 // The object (instance custom index) and its cell (index into cells[]) of
 // the candidate or committed intersection; `committed` must be a literal.
 #define candidateObject(rq, committed) uint(rayQueryGetIntersectionInstanceCustomIndexEXT(rq, committed))

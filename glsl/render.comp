@@ -15,24 +15,7 @@ layout(local_size_x = RENDER_GROUP, local_size_y = RENDER_GROUP) in;
 layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials { Material materials[]; };
 layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
 
-// Camera basis: ray direction = forward + x right + y up, x and y in [-1, 1].
-layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
-    vec3 eye;
-    vec3 forward;
-    vec3 right;
-    vec3 up;
-    vec3 background;
-    uint width;
-    uint height;
-    uint seed;
-    uint lightCount;
-    uint maxDepth;
-    uint envMap;      // texture index of the environment map, or NO_TEXTURE
-    uint envWidth;
-    uint envHeight;
-    float envScale;
-    Medium fog;       // outside the objects (density 0: none)
-} frame;
+#include "frame.glsl"
 
 // rgb: summed radiance, a: sample count.
 layout(set = 0, binding = BINDING_ACCUM, rgba32f) uniform image2D accum;
@@ -56,6 +39,24 @@ vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index
 // Specialisation constant: 1 when the scene has a participating medium (the
 // fog or a dielectric's interior); 0 compiles the media code out.
 layout(constant_id = 3) const uint MEDIA_ENABLED = 0u;
+
+// Specialisation constant: 1 when the caustic passes ran: the primary
+// diffuse vertex reads the caustic map, and the paths it covers are left out
+// (see "caustic paths" in tracePath); 0 compiles this out.
+layout(constant_id = 4) const uint CAUSTICS_ENABLED = 0u;
+
+// Specialisation constant: 1 when the volume pass ran: the camera ray's
+// first segment gets its in-scattered light from it, and leaves single
+// scattering toward positional lights out of its own estimate; 0 compiles
+// this out.
+layout(constant_id = 5) const uint VOLUME_ENABLED = 0u;
+
+// In-scattered radiance per pixel from the volume pass (volume.comp).
+layout(set = 0, binding = BINDING_RENDER_VOLUME, scalar) readonly buffer Volume { float volume[]; };
+
+#include "caustics.glsl"
+layout(set = 0, binding = BINDING_RENDER_GBUFFER, scalar) readonly buffer Receivers { Receiver receivers[]; };
+layout(set = 0, binding = BINDING_RENDER_CAUSTICS, scalar) readonly buffer CausticMap { uint64_t causticMap[]; };
 
 // Specialisation constant: FILTER_NONE, FILTER_RAY_CONES or FILTER_COVARIANCE.
 layout(constant_id = 2) const uint FILTER_MODE = FILTER_NONE;
@@ -206,18 +207,6 @@ layout(constant_id = 1) const uint SHADING_MODE = SHADING_FULL;
 // Bounces after which Russian roulette may end a path.
 const uint RR_DEPTH = 3u;
 
-vec3 cameraRay(vec2 pixel) {
-    vec2 ndc = vec2(2.0 * pixel.x / float(frame.width) - 1.0, 1.0 - 2.0 * pixel.y / float(frame.height));
-    return normalize(frame.forward + ndc.x * frame.right + ndc.y * frame.up);
-}
-
-// Offset along the geometric normal, to the side of `dir`, that keeps a
-// secondary ray off its own surface.
-vec3 offsetOrigin(vec3 p, vec3 n, vec3 dir) {
-    float scale = max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
-    return p + (dot(dir, n) >= 0.0 ? n : -n) * (2e-4 * scale);
-}
-
 bool environmentLit() { return frame.envMap != NO_TEXTURE || any(greaterThan(frame.background, vec3(0.0))); }
 
 // Light index `frame.lightCount` stands for the uniform environment (the
@@ -231,31 +220,7 @@ float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
     return i == frame.lightCount ? environmentPdf(wi) : lightPdf(lights[i], x, wi);
 }
 
-// The first area light other than `except` that o + t d meets before tmax:
-// its index (or frame.lightCount when none) and distance.
-uint firstLightHit(vec3 o, vec3 d, float tmax, uint except, out float tHit) {
-    uint which = frame.lightCount;
-    tHit = tmax;
-    for (uint i = 0; i < frame.lightCount; ++i) {
-        if (i == except) continue;
-        float t = lightHit(lights[i], o, d);
-        if (t < tHit) {
-            tHit = t;
-            which = i;
-        }
-    }
-    return which;
-}
-
-// True when nothing blocks the shadow ray from `origin` along wi over
-// `dist` toward light `i`: no geometry, and no other sphere or rect light in
-// front (lights are not in the acceleration structure, so they may hide
-// each other).
-bool lightVisible(vec3 origin, vec3 wi, float dist, uint i) {
-    if (occluded(origin, wi, 0.0, dist)) return false;
-    float tl;
-    return firstLightHit(origin, wi, dist, i, tl) == frame.lightCount;
-}
+#include "light_queries.glsl"
 
 // Number of light-sampling choices: the lights, plus the environment.
 uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
@@ -307,16 +272,6 @@ vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis,
     return contribution * (w / ls.pdf);
 }
 
-// True for lights with a position (point, sphere, rect): the ones the
-// equiangular estimate aims at.
-bool positionalLight(uint i) { return i < frame.lightCount && lights[i].kind != LIGHT_DIRECTIONAL; }
-
-vec3 lightCentre(uint i) {
-    Light l = lights[i];
-    vec3 c = v3(l.position);
-    return l.kind == LIGHT_RECT ? c + 0.5 * (v3(l.edgeU) + v3(l.edgeV)) : c;
-}
-
 // Single scattering toward positional light `i` (chosen with probability
 // `select`) along the medium segment o + t d, t in [0, tEnd): a point by
 // equiangular sampling, a direction by the light's sampler, weighted by
@@ -342,24 +297,6 @@ vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float 
     return f * (w / pA);
 }
 
-// The media as local values (copied field by field: glslang mis-types a
-// direct copy of structs between blocks of different layouts).
-Medium materialMedium(uint material) {
-    Medium m;
-    m.density = materials[material].medium.density;
-    m.albedo = materials[material].medium.albedo;
-    m.anisotropy = materials[material].medium.anisotropy;
-    return m;
-}
-
-Medium fogMedium() {
-    Medium m;
-    m.density = frame.fog.density;
-    m.albedo = frame.fog.albedo;
-    m.anisotropy = frame.fog.anisotropy;
-    return m;
-}
-
 // Russian roulette after RR_DEPTH bounces: false when the path ends.
 bool survives(inout vec3 throughput, uint bounce, inout uint rng) {
     if (bounce + 1u < RR_DEPTH) return true;
@@ -369,20 +306,16 @@ bool survives(inout vec3 throughput, uint bounce, inout uint rng) {
     return true;
 }
 
-// Nested dielectrics: the path keeps a stack of the dielectric materials it
-// is inside (innermost last). A dielectric surface is an interface between
-// its material and the medium on its other side: when the ray enters, the
-// medium it comes from (the top of the stack); when it leaves, the medium
-// below this material in the stack. Its relative index is the ratio of the
-// two. A transmission pushes the material (entering) or removes it
-// (leaving). This is right for properly nested objects (a bubble in glass,
-// glass in water); coincident or overlapping interfaces would need
-// priorities (Schmidt & Budge 2002). Paths start in vacuum (index 1).
-const uint MEDIA_STACK = 4u;
+#include "stack.glsl"
 
-vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
-    uint media[MEDIA_STACK];
-    uint mediaCount = 0u;
+// Caustic paths: with CAUSTICS_ENABLED, the caustic map gives the light that
+// reaches the primary vertex (when it is the diffuse receiver seen through
+// the pixel centre) from point, sphere and directional lights through one or
+// more specular vertices of the kinds caustic_trace.comp follows. The path
+// therefore ignores a sphere light it finds after leaving that vertex
+// through such vertices only; every other path is estimated as usual.
+vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
+    MediaStack media = emptyStack();
     // Ray cone (Akenine-Möller et al., "Improved Shader and Texture Level of
     // Detail Using Ray Cones", JCGT 2021): width at the ray's origin and
     // spread angle, starting from the pixel's angle at the camera. Curved
@@ -406,11 +339,24 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
     float scatterT = 0.0;
     float scatterDensity = 0.0;
     uint choices = lightChoices();
+    // Caustic paths: true while the path has gone from the primary receiver
+    // through the specular vertices that the caustic map covers; their count.
+    bool causticPath = false;
+    uint causticSpeculars = 0u;
+    // True when the last scattering event was on the camera ray's first
+    // segment and the volume pass covers it (VOLUME_ENABLED).
+    bool scatteredOnVolumeSegment = false;
     // Crossing an index-matched interface (relative index 1: the same medium
     // on both sides) is not a bounce; `step` bounds the loop all the same.
     uint bounce = 0u;
     for (uint step = 0u; bounce < frame.maxDepth && step < 4u * frame.maxDepth + 8u; ++step) {
         SceneHit h = traceScene(o, d, 0.0, 1e30);
+        // The camera ray's first segment: the volume pass has its single
+        // scattering toward positional lights.
+        bool volumeSegment = VOLUME_ENABLED != 0u && step == 0u;
+        if (volumeSegment) radiance += vec3(volume[3u * pixel], volume[3u * pixel + 1u], volume[3u * pixel + 2u]);
+        bool afterVolumeScatter = scatteredOnVolumeSegment;
+        scatteredOnVolumeSegment = false;
         float tl;
         uint which = firstLightHit(o, d, h.object == NO_HIT ? 1e30 : h.t, frame.lightCount, tl);
         // Participating media: the medium the ray travels in (the innermost
@@ -418,7 +364,7 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         // before it reaches the surface or light at tl (distance sampling:
         // the event's weight is the albedo; passing through weighs 1).
         Medium med = Medium(0.0, float[3](0.0, 0.0, 0.0), 0.0);
-        if (MEDIA_ENABLED != 0u) med = mediaCount > 0u ? materialMedium(media[mediaCount - 1u]) : fogMedium();
+        if (MEDIA_ENABLED != 0u) med = mediumOf(media);
         if (MEDIA_ENABLED != 0u && SHADING_MODE == SHADING_FULL && med.density > 0.0) {
             // One light for this segment's single scattering: a positional
             // light gets the equiangular estimate over the whole segment;
@@ -429,7 +375,9 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
             float select = 1.0 / float(max(choices, 1u));
             bool last = bounce + 1u == frame.maxDepth;
             bool positional = choices > 0u && positionalLight(li);
-            if (positional) radiance += throughput * equiangularNextEvent(med, o, d, tl, li, select, !last, rng);
+            if (positional && !volumeSegment) {
+                radiance += throughput * equiangularNextEvent(med, o, d, tl, li, select, !last, rng);
+            }
             float ts = -log(1.0 - rand(rng)) / med.density;
             if (ts < tl) {
                 vec3 p = o + ts * d;
@@ -457,6 +405,8 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
                 }
                 d = wi;
                 o = p;
+                causticPath = false;
+                scatteredOnVolumeSegment = volumeSegment;
                 if (!survives(throughput, bounce, rng)) break;
                 ++bounce;
                 continue;
@@ -475,7 +425,12 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
             } else if (lastPdf > 0.0 && (which != frame.lightCount || environmentLit())) {
                 w = powerHeuristic(lastPdf, lightOrEnvironmentPdf(which, lastPoint, d) / float(choices));
             }
-            radiance += throughput * le * w;
+            bool coveredByCaustics = causticPath && causticSpeculars > 0u && which != frame.lightCount
+                && lights[which].kind == LIGHT_SPHERE;
+            // Single scattering on the camera ray's first segment toward a
+            // sphere or rect light is the volume pass's.
+            bool coveredByVolume = afterVolumeScatter && which != frame.lightCount;
+            if (!coveredByCaustics && !coveredByVolume) radiance += throughput * le * w;
             break;
         }
 
@@ -501,32 +456,10 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         uint matIndex = objects[h.object].material;
         bool entering = dot(d, h.normal) < 0.0;
         if (mat.kind == MATERIAL_DIELECTRIC) {
-            // The medium on the far side of this interface.
-            float outside = 1.0;
-            if (entering) {
-                if (mediaCount > 0u) outside = materials[media[mediaCount - 1u]].ior;
-            } else {
-                for (uint k = mediaCount; k > 0u; --k) {
-                    if (media[k - 1u] == matIndex) {
-                        if (k > 1u) outside = materials[media[k - 2u]].ior;
-                        break;
-                    }
-                }
-            }
-            mat.ior /= outside;
+            mat.ior /= farSideIor(media, matIndex, entering);
             if (abs(mat.ior - 1.0) < 1e-6) {
                 // Invisible interface: continue straight on, into or out of this medium.
-                if (entering) {
-                    if (mediaCount < MEDIA_STACK) media[mediaCount++] = matIndex;
-                } else {
-                    for (uint k = mediaCount; k > 0u; --k) {
-                        if (media[k - 1u] == matIndex) {
-                            for (uint j = k - 1u; j + 1u < mediaCount; ++j) media[j] = media[j + 1u];
-                            --mediaCount;
-                            break;
-                        }
-                    }
-                }
+                crossInterface(media, matIndex, entering);
                 o = offsetOrigin(o + h.t * d, h.normal, d);
                 continue;
             }
@@ -538,11 +471,28 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
         mat3 frameW = frameAround(n);
         vec3 wo = transpose(frameW) * -d;
         bool last = bounce + 1u == frame.maxDepth;
+        bool primaryReceiver = CAUSTICS_ENABLED != 0u && bounce == 0u && mat.kind == MATERIAL_DIFFUSE
+            && receivers[pixel].object == h.object;
+        if (primaryReceiver) radiance += throughput * v3(mat.albedo) / PI * CAUSTIC_IRRADIANCE(causticMap, pixel);
         if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, med, !last, rng);
         if (last) break;
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
         if (!bs.valid) break;
+        if (CAUSTICS_ENABLED != 0u) {
+            // The caustic rays pass dielectrics by refraction (reflection
+            // only under total internal reflection) and reflect off mirrors
+            // and smooth conductors.
+            bool reflectedOffGlass = mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z > 0.0
+                && fresnelDielectric(wo.z, mat.ior) < 1.0;
+            if (primaryReceiver) {
+                causticPath = true;
+            } else if (causticPath && isDelta(mat) && !reflectedOffGlass) {
+                ++causticSpeculars;
+            } else {
+                causticPath = false;
+            }
+        }
         if (FILTER_MODE != FILTER_NONE) {
             // The outgoing footprint: the normal facing the incoming ray tilts
             // by S u at surface offset u (S: its shape operator, exact from
@@ -579,20 +529,8 @@ vec3 tracePath(vec3 o, vec3 d, inout uint rng) {
                 coneWidth = width;
             }
         }
-        if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) {
-            // Transmitted: update the stack of media.
-            if (entering) {
-                if (mediaCount < MEDIA_STACK) media[mediaCount++] = matIndex;
-            } else {
-                for (uint k = mediaCount; k > 0u; --k) {
-                    if (media[k - 1u] == matIndex) {
-                        for (uint j = k - 1u; j + 1u < mediaCount; ++j) media[j] = media[j + 1u];
-                        --mediaCount;
-                        break;
-                    }
-                }
-            }
-        }
+        // Transmitted: update the stack of media.
+        if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) crossInterface(media, matIndex, entering);
         throughput *= bs.weight;
         lastPdf = bs.pdf;
         scatterDensity = 0.0;
@@ -628,7 +566,7 @@ void main() {
         aovs[idx] = aov;
     }
 
-    vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + rand2(rng)), rng);
+    vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + rand2(rng)), idx, rng);
     // No NaN or Inf ever leaves the renderer.
     if (any(isnan(radiance)) || any(isinf(radiance))) radiance = vec3(0.0);
     ivec2 at = ivec2(pix);

@@ -514,6 +514,8 @@ fn cached_reference(
                     aov: vec![],
                     spp: info.spp,
                     seconds: stored.seconds,
+                    caustics: None,
+                    volume_seconds: None,
                 };
                 return Ok((out, stored));
             }

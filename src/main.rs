@@ -126,6 +126,23 @@ struct RenderArgs {
     /// write the full render's outputs.
     #[arg(long)]
     bench: bool,
+    /// Caustic rays per light and light sample (overrides `caustics.rays`; 0
+    /// switches the caustic passes off).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16_777_216))]
+    caustic_rays: Option<u32>,
+    /// Points on each sphere light that emit caustic rays (overrides
+    /// `caustics.light_samples`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    caustic_light_samples: Option<u32>,
+    /// Camera rays per pixel and render sample of the volume pass (overrides
+    /// `volume.samples`; 0 switches the volume pass off).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=65536))]
+    volume_samples: Option<u32>,
+    /// Brute force: no caustic or volume passes; the path tracer alone
+    /// estimates caustics and the light scattered by the fog (the reference
+    /// those passes are compared with).
+    #[arg(long)]
+    brute_force: bool,
 }
 
 /// Texture filtering modes of `--filter`.
@@ -218,6 +235,15 @@ fn load(args: &RenderArgs) -> Result<Scene> {
     if let Some(h) = args.height {
         scene.image.height = h;
     }
+    if let Some(r) = args.caustic_rays {
+        scene.caustics.rays = r;
+    }
+    if let Some(k) = args.caustic_light_samples {
+        scene.caustics.light_samples = k;
+    }
+    if let Some(n) = args.volume_samples {
+        scene.volume.samples = n;
+    }
     if let Some(s) = args.seed {
         scene.image.seed = s;
     }
@@ -248,7 +274,12 @@ fn render(args: RenderArgs) -> Result<()> {
         bench(&ctx, &scene, filter)?
     } else {
         let mut progress = ProgressLine::new(args.progress);
-        let variant = quadray::passes::RenderVariant { filter, ..Default::default() };
+        let variant = quadray::passes::RenderVariant {
+            filter,
+            caustics: !args.brute_force,
+            volume: !args.brute_force,
+            ..Default::default()
+        };
         let out = quadray::render_scene_with(&ctx, &scene, variant, &mut |d, t| progress.update(d, t));
         progress.finish();
         out.context("render failed")?
@@ -267,6 +298,21 @@ fn render(args: RenderArgs) -> Result<()> {
         })
         .collect();
     write_outputs(&out, &files)?;
+    if let Some(c) = &out.caustics {
+        eprintln!(
+            "caustics: {} rays in {} grid(s), {} landed on a receiver; {:.3} s (G-buffer {:.3}, rays {:.3}, cells {:.3})",
+            c.rays,
+            c.grids,
+            c.landed,
+            c.seconds(),
+            c.gbuffer_seconds,
+            c.trace_seconds,
+            c.splat_seconds
+        );
+    }
+    if let Some(v) = out.volume_seconds {
+        eprintln!("volume: {} camera rays per pixel; {v:.3} s", scene.volume.samples.saturating_mul(out.spp));
+    }
     let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
     eprintln!(
         "wrote {} ({}x{}, {} spp, {:.2} s on {})",
@@ -299,12 +345,21 @@ fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> Result<quadr
     )?;
     let im = &scene.image;
     let variants = [
-        ("full render", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter }),
-        ("perturbation root finding off", RenderVariant { intersect: INTERSECT_BASE, shading: SHADING_FULL, filter }),
-        ("shading and secondary rays off", RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_NONE, filter }),
+        (
+            "full render",
+            RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter, ..Default::default() },
+        ),
+        (
+            "perturbation root finding off",
+            RenderVariant { intersect: INTERSECT_BASE, shading: SHADING_FULL, filter, ..Default::default() },
+        ),
+        (
+            "shading and secondary rays off",
+            RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_NONE, filter, ..Default::default() },
+        ),
         (
             "traversal only (boxes are hits, no shading)",
-            RenderVariant { intersect: INTERSECT_BOXES, shading: SHADING_NONE, filter },
+            RenderVariant { intersect: INTERSECT_BOXES, shading: SHADING_NONE, filter, ..Default::default() },
         ),
     ];
     eprintln!(

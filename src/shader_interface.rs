@@ -90,3 +90,27 @@ pub const FILTER_RAY_CONES: u32 = 1;
 /// Texture filtering: covariance footprints carried along the path (the
 /// paper's method), with EWA lookups.
 pub const FILTER_COVARIANCE: u32 = 2;
+/// Descriptor binding of the caustic rays' landings (caustic passes).
+pub const BINDING_CAUSTIC_RAYS: u32 = 8;
+/// Descriptor binding of the G-buffer of pixel-centre receivers (G-buffer
+/// and caustic splat passes).
+pub const BINDING_GBUFFER: u32 = 9;
+/// Descriptor binding of the caustic irradiance buffer (caustic splat pass).
+pub const BINDING_CAUSTIC_MAP: u32 = 10;
+/// Descriptor binding of the G-buffer (render pass).
+pub const BINDING_RENDER_GBUFFER: u32 = 12;
+/// Descriptor binding of the caustic irradiance buffer (render pass).
+pub const BINDING_RENDER_CAUSTICS: u32 = 13;
+/// Workgroup size of the caustic passes.
+pub const CAUSTIC_GROUP: u32 = 64;
+/// Caustic emitter: rays from a point (point and sphere lights).
+pub const EMITTER_POINT: u32 = 0;
+/// Caustic emitter: parallel rays (directional lights).
+pub const EMITTER_PARALLEL: u32 = 1;
+/// Fixed-point scale of the caustic irradiance buffer (64-bit integer
+/// atomics): irradiance × 2^20 is added per pixel and channel.
+pub const CAUSTIC_FIXED_POINT: u32 = 1048576;
+/// Descriptor binding of the in-scattered radiance per pixel (volume pass).
+pub const BINDING_VOLUME: u32 = 8;
+/// Descriptor binding of the in-scattered radiance per pixel (render pass).
+pub const BINDING_RENDER_VOLUME: u32 = 14;

@@ -26,3 +26,24 @@ pub fn probe() -> Vec<u32> {
 pub fn texprobe() -> Vec<u32> {
     words(include_bytes!(concat!(env!("OUT_DIR"), "/texprobe.comp.spv")))
 }
+
+/// `glsl/gbuffer.comp`: the surface seen through each pixel centre.
+pub fn gbuffer() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer.comp.spv")))
+}
+
+/// `glsl/caustic_trace.comp`: caustic rays from the lights through the
+/// specular objects.
+pub fn caustic_trace() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/caustic_trace.comp.spv")))
+}
+
+/// `glsl/caustic_splat.comp`: caustic cells splatted into the caustic map.
+pub fn caustic_splat() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/caustic_splat.comp.spv")))
+}
+
+/// `glsl/volume.comp`: single scattering in the fog toward positional lights.
+pub fn volume() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/volume.comp.spv")))
+}

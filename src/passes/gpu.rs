@@ -427,7 +427,66 @@ pub struct ProbePush {
     pub count: u32,
 }
 
+/// `CausticRay` in caustics.glsl: where a caustic ray landed.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuCausticRay {
+    /// Landing point (GPU frame).
+    pub position: [f32; 3],
+    /// Object landed on (`NO_HIT` for an invalid ray).
+    pub object: u32,
+    /// Flux carried when landing (W, RGB).
+    pub flux: [f32; 3],
+    /// Identifier of the sequence of surfaces; 0 marks an invalid ray.
+    pub path: u32,
+}
+
+/// `Receiver` in caustics.glsl: the first surface through a pixel's centre.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuReceiver {
+    /// Hit point (GPU frame).
+    pub position: [f32; 3],
+    /// Object hit, or `NO_HIT`.
+    pub object: u32,
+}
+
+/// `Emitter` in caustics.glsl: one grid of caustic rays (push constants of
+/// the caustic passes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuEmitter {
+    /// Point emitters: the light's position; parallel: the grid plane's centre.
+    pub origin: [f32; 3],
+    /// `EMITTER_POINT` or `EMITTER_PARALLEL`.
+    pub kind: u32,
+    /// Grid plane axis (unit).
+    pub u: [f32; 3],
+    /// Index of the grid's first ray in the ray buffer.
+    pub first_ray: u32,
+    /// Grid plane axis (unit).
+    pub v: [f32; 3],
+    /// Specular vertices a ray may pass before it lands.
+    pub max_specular: u32,
+    /// Emission axis (unit): toward the grid plane at distance 1 (point), or
+    /// the rays' direction (parallel).
+    pub w: [f32; 3],
+    /// Padding.
+    pub pad: f32,
+    /// Lower corner of the grid rectangle in (u, v).
+    pub lo: [f32; 2],
+    /// Upper corner of the grid rectangle in (u, v).
+    pub hi: [f32; 2],
+    /// Rays along u and along v.
+    pub grid: [u32; 2],
+    /// Intensity (W/sr, point) or irradiance (W/m², parallel), RGB.
+    pub power: [f32; 3],
+}
+
 const _: () = {
+    assert!(std::mem::size_of::<GpuCausticRay>() == 32);
+    assert!(std::mem::size_of::<GpuReceiver>() == 16);
+    assert!(std::mem::size_of::<GpuEmitter>() == 100);
     assert!(std::mem::size_of::<GpuQuadric>() == 40);
     assert!(std::mem::size_of::<GpuObject>() == 92);
     assert!(std::mem::size_of::<GpuPerturbation>() == 60);

@@ -1,13 +1,17 @@
 //! GPU passes, one a file: the scene upload, the render pass, and the probe
 //! passes (rays, texture lookups) used by tests and benchmarks.
 
+pub mod caustics;
 pub mod gpu;
 pub mod probe;
 pub mod render;
 pub mod scene_gpu;
 pub mod texprobe;
+pub mod volume;
 
+pub use caustics::{CausticMap, CausticReport};
 pub use probe::ProbePass;
 pub use render::{render, RenderOutput, RenderVariant};
 pub use scene_gpu::{GeometryStats, GpuScene};
 pub use texprobe::TexProbePass;
+pub use volume::VolumeLight;

@@ -5,8 +5,10 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::caustics::{emitters, CausticMap, CausticReport};
 use super::gpu::{GpuAov, GpuFrame, GpuMedium, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
+use super::volume::VolumeLight;
 use crate::scene::Scene;
 use crate::shader_interface::{FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
 use crate::vk::{
@@ -29,8 +31,12 @@ pub struct RenderOutput {
     pub aov: Vec<GpuAov>,
     /// Samples per pixel taken.
     pub spp: u32,
-    /// Wall time of the GPU work in seconds.
+    /// Wall time of the GPU work in seconds (the caustic passes included).
     pub seconds: f64,
+    /// What the caustic passes did, when they ran.
+    pub caustics: Option<CausticReport>,
+    /// Wall time of the volume pass (s), when it ran.
+    pub volume_seconds: Option<f64>,
 }
 
 /// Progress of a render: (work done, total work), in tile-samples.
@@ -48,11 +54,17 @@ pub struct RenderVariant {
     pub shading: u32,
     /// Texture filtering: `FILTER_NONE`, `FILTER_RAY_CONES` or `FILTER_COVARIANCE`.
     pub filter: u32,
+    /// Run the caustic passes when the scene needs them (false: the path
+    /// tracer alone estimates caustics, by brute force).
+    pub caustics: bool,
+    /// Run the volume pass when the scene needs it (false: the path tracer
+    /// alone estimates the light scattered by the fog).
+    pub volume: bool,
 }
 
 impl Default for RenderVariant {
     fn default() -> Self {
-        Self { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter: FILTER_NONE }
+        Self { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter: FILTER_NONE, caustics: true, volume: true }
     }
 }
 
@@ -87,6 +99,33 @@ pub fn render(
         fog: GpuMedium::from(scene.fog.as_ref()),
     };
     let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
+    let caustics = caustic_map(device, cmds, gpu, scene, &frame_buf, (width, height), variant)?;
+    // Placeholders for the render shader's caustic bindings when the passes did not run.
+    let placeholder =
+        |name| Buffer::new(device, name, 24, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuOnly);
+    let (receivers_placeholder, map_placeholder) = match caustics {
+        Some(_) => (None, None),
+        None => (Some(placeholder("no receivers")?), Some(placeholder("no caustic map")?)),
+    };
+    let receivers = caustics.as_ref().map_or_else(|| receivers_placeholder.as_ref().unwrap(), |c| &c.receivers);
+    let caustic_map = caustics.as_ref().map_or_else(|| map_placeholder.as_ref().unwrap(), |c| &c.map);
+    let volume = if variant.volume && variant.shading == SHADING_FULL && scene.needs_volume() {
+        Some(VolumeLight::compute(
+            device,
+            cmds,
+            gpu,
+            &frame_buf,
+            (width, height),
+            scene.volume.samples.saturating_mul(spp),
+        )?)
+    } else {
+        None
+    };
+    let volume_placeholder = match volume {
+        Some(_) => None,
+        None => Some(placeholder("no volume radiance")?),
+    };
+    let volume_radiance = volume.as_ref().map_or_else(|| volume_placeholder.as_ref().unwrap(), |v| &v.radiance);
     let accum = Image::new(
         device,
         "accumulation",
@@ -116,13 +155,23 @@ pub fn render(
         BindingKind::StorageBuffer,
         BindingKind::SampledImages(MAX_TEXTURES),
         BindingKind::StorageBuffer,
+        BindingKind::StorageBuffer,
+        BindingKind::StorageBuffer,
+        BindingKind::StorageBuffer,
     ]);
     let pipeline = ComputePipeline::new(
         device,
         &shaders::render(),
         &kinds,
         std::mem::size_of::<RenderPush>() as u32,
-        &[variant.intersect, variant.shading, variant.filter, u32::from(scene.has_media())],
+        &[
+            variant.intersect,
+            variant.shading,
+            variant.filter,
+            u32::from(scene.has_media()),
+            u32::from(caustics.is_some()),
+            u32::from(volume.is_some()),
+        ],
     )?;
     let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
     pipeline.bind(&[
@@ -138,6 +187,9 @@ pub fn render(
         Binding::Buffer(&aov),
         gpu.texture_binding(),
         Binding::Buffer(&gpu.env_cdf),
+        Binding::Buffer(receivers),
+        Binding::Buffer(caustic_map),
+        Binding::Buffer(volume_radiance),
     ]);
 
     let tiles: Vec<[u32; 4]> = (0..height)
@@ -172,7 +224,11 @@ pub fn render(
             progress(done, total);
         }
     }
-    let seconds = start.elapsed().as_secs_f64();
+    let report = caustics.map(|c| c.report);
+    let volume_seconds = volume.as_ref().map(|v| v.seconds);
+    let seconds = start.elapsed().as_secs_f64()
+        + report.as_ref().map_or(0.0, CausticReport::seconds)
+        + volume_seconds.unwrap_or(0.0);
 
     cmds.run(|d, cmd| {
         full_barrier(d, cmd);
@@ -190,5 +246,31 @@ pub fn render(
         .collect();
     let mut aovs: Vec<GpuAov> = aov.read();
     aovs.truncate(pixels as usize);
-    Ok(RenderOutput { width, height, radiance, aov: aovs, spp, seconds })
+    Ok(RenderOutput { width, height, radiance, aov: aovs, spp, seconds, caustics: report, volume_seconds })
+}
+
+/// Runs the caustic passes when `variant` asks for them and the scene needs
+/// them: a light that emits caustic rays, a specular object, a diffuse
+/// receiver, and a path depth that allows a specular vertex between a
+/// receiver and a light (max_depth ≥ 3).
+fn caustic_map(
+    device: &Arc<Device>,
+    cmds: &mut Commands,
+    gpu: &GpuScene,
+    scene: &Scene,
+    frame: &Buffer,
+    size: (u32, u32),
+    variant: RenderVariant,
+) -> Result<Option<CausticMap>, RenderError> {
+    let max_depth = scene.image.max_depth.max(1);
+    if !variant.caustics || variant.shading != SHADING_FULL || !scene.needs_caustics() || max_depth < 3 {
+        return Ok(None);
+    }
+    // A caustic path from the camera: the receiver (a bounce), the specular
+    // vertices (a bounce each), then the light found by the next segment.
+    let Some(grids) = emitters(scene, gpu.origin, max_depth - 2) else {
+        log::warn!("a light is inside the bounds of the specular objects: caustics are left to the path tracer");
+        return Ok(None);
+    };
+    Ok(Some(CausticMap::compute(device, cmds, gpu, scene, frame, size, &grids)?))
 }

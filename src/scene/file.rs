@@ -32,8 +32,9 @@ use toml::Spanned;
 use crate::hash::hash_unit;
 
 use super::{
-    Camera, ConductorFresnel, EnvironmentMapSettings, ImageSettings, Light, Material, MaterialKind, MaterialMaps,
-    Medium, Scene, SceneObject, TextureImage, UvMapping, UvSettings,
+    Camera, CausticSettings, ConductorFresnel, EnvironmentMapSettings, ImageSettings, Light, Material, MaterialKind,
+    MaterialMaps, Medium, Scene, SceneObject, TextureImage, UvMapping, UvSettings, VolumeSettings,
+    DEFAULT_CAUSTIC_LIGHT_SAMPLES, DEFAULT_CAUSTIC_RAYS, DEFAULT_VOLUME_SAMPLES,
 };
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 use crate::sampling::envmap::procedural_sky;
@@ -53,6 +54,12 @@ pub const MAX_SPP: i64 = 1 << 20;
 pub const DEFAULT_MAX_DEPTH: u32 = 6;
 /// Largest accepted `[image] max_depth`.
 pub const MAX_DEPTH: i64 = 64;
+/// Largest accepted `[caustics] rays` (per light and light sample).
+pub const MAX_CAUSTIC_RAYS: i64 = 1 << 24;
+/// Largest accepted `[caustics] light_samples`.
+pub const MAX_CAUSTIC_LIGHT_SAMPLES: i64 = 1024;
+/// Largest accepted `[volume] samples`.
+pub const MAX_VOLUME_SAMPLES: i64 = 65536;
 /// Largest accepted `count` of a `[[objects.scatter]]` generator.
 pub const MAX_SCATTER_COUNT: i64 = 1_000_000;
 /// Name of the built-in material given to objects without a `material` key.
@@ -364,6 +371,9 @@ type Dimension = Int<1, MAX_IMAGE_SIZE>;
 type Samples = Int<1, MAX_SPP>;
 type Seed = Int<0, { u32::MAX as i64 }>;
 type Depth = Int<1, MAX_DEPTH>;
+type CausticRays = Int<0, MAX_CAUSTIC_RAYS>;
+type LightSamples = Int<1, MAX_CAUSTIC_LIGHT_SAMPLES>;
+type VolumeSamples = Int<0, MAX_VOLUME_SAMPLES>;
 type Count = Int<1, MAX_SCATTER_COUNT>;
 type Sheets = Int<1, 2>;
 
@@ -711,6 +721,8 @@ struct RawScene {
     background: Option<Spanned<Triple<NonNegative>>>,
     environment: Option<Spanned<RawEnvironment>>,
     fog: Option<Spanned<RawMedium>>,
+    caustics: Option<RawCaustics>,
+    volume: Option<RawVolume>,
     image: Option<RawImage>,
     camera: Spanned<RawCamera>,
     #[serde(default)]
@@ -730,6 +742,19 @@ struct RawImage {
     seed: Option<Seed>,
     exposure: Option<Exposure>,
     max_depth: Option<Depth>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a [volume] table")]
+struct RawVolume {
+    samples: Option<VolumeSamples>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a [caustics] table")]
+struct RawCaustics {
+    rays: Option<CausticRays>,
+    light_samples: Option<LightSamples>,
 }
 
 #[derive(Deserialize)]
@@ -1181,7 +1206,27 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
     };
 
     let fog = raw.fog.as_ref().map(|f| f.get_ref().build());
-    Ok(Scene { image, camera, background, materials, objects, lights, environment, textures: textures.images, fog })
+    let caustics = raw.caustics.as_ref();
+    let caustics = CausticSettings {
+        rays: caustics.and_then(|c| c.rays).map_or(DEFAULT_CAUSTIC_RAYS, |v| v.get() as u32),
+        light_samples: caustics.and_then(|c| c.light_samples).map_or(DEFAULT_CAUSTIC_LIGHT_SAMPLES, |v| v.get() as u32),
+    };
+    let volume = VolumeSettings {
+        samples: raw.volume.as_ref().and_then(|v| v.samples).map_or(DEFAULT_VOLUME_SAMPLES, |v| v.get() as u32),
+    };
+    Ok(Scene {
+        volume,
+        image,
+        camera,
+        background,
+        materials,
+        objects,
+        lights,
+        environment,
+        textures: textures.images,
+        fog,
+        caustics,
+    })
 }
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {

@@ -271,6 +271,77 @@ pub struct Scene {
     pub environment: Option<EnvironmentMapSettings>,
     /// A medium filling all space outside the objects (fog), if any.
     pub fog: Option<Medium>,
+    /// The caustic passes' settings (`[caustics]`).
+    pub caustics: CausticSettings,
+    /// The volume pass's settings (`[volume]`).
+    pub volume: VolumeSettings,
+}
+
+/// Settings of the volumetric-lighting pass (`[volume]` in a scene file).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumeSettings {
+    /// Camera rays per pixel and per sample of the render (so the volume
+    /// pass converges with the render) along which single scattering toward
+    /// the positional lights is estimated (0: no volume pass; the path
+    /// tracer then estimates it).
+    pub samples: u32,
+}
+
+/// Default `[volume] samples`.
+pub const DEFAULT_VOLUME_SAMPLES: u32 = 1;
+
+impl Default for VolumeSettings {
+    fn default() -> Self {
+        Self { samples: DEFAULT_VOLUME_SAMPLES }
+    }
+}
+
+/// Settings of the caustic passes (`[caustics]` in a scene file).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CausticSettings {
+    /// Caustic rays per light and light sample (0: no caustic passes; the
+    /// path tracer then estimates caustics by brute force).
+    pub rays: u32,
+    /// Points on each sphere light from which the rays are emitted (its
+    /// extent softens the caustics); point and directional lights use one.
+    pub light_samples: u32,
+}
+
+/// Default `[caustics] rays`.
+pub const DEFAULT_CAUSTIC_RAYS: u32 = 65536;
+/// Default `[caustics] light_samples`.
+pub const DEFAULT_CAUSTIC_LIGHT_SAMPLES: u32 = 16;
+
+impl Default for CausticSettings {
+    fn default() -> Self {
+        Self { rays: DEFAULT_CAUSTIC_RAYS, light_samples: DEFAULT_CAUSTIC_LIGHT_SAMPLES }
+    }
+}
+
+/// Below this GGX α (roughness²) a lobe is a perfect specular (delta) lobe,
+/// as in the shaders (`ALPHA_DELTA` in bsdf.glsl).
+pub const ALPHA_DELTA: f32 = 1e-3;
+
+impl Material {
+    /// True for the perfect specular surfaces that caustic rays pass:
+    /// mirrors, smooth conductors and smooth dielectrics.
+    pub fn is_specular(&self) -> bool {
+        match self.kind {
+            MaterialKind::Mirror => true,
+            MaterialKind::Conductor { roughness, .. } | MaterialKind::Dielectric { roughness, .. } => {
+                roughness * roughness < ALPHA_DELTA
+            }
+            MaterialKind::Diffuse => false,
+        }
+    }
+}
+
+impl Light {
+    /// True for the lights that emit caustic rays: point, sphere and
+    /// directional lights (rect lights' caustics are left to the path tracer).
+    pub fn emits_caustic_rays(&self) -> bool {
+        !matches!(self, Light::Rect { .. })
+    }
 }
 
 impl Scene {
@@ -279,6 +350,25 @@ impl Scene {
     /// otherwise.
     pub fn has_media(&self) -> bool {
         self.fog.iter().chain(self.materials.iter().filter_map(|m| m.medium.as_ref())).any(|m| m.density > 0.0)
+    }
+
+    /// True when the volume pass has work: volume samples are enabled, and
+    /// the scene has fog and a point, sphere or rect light.
+    pub fn needs_volume(&self) -> bool {
+        self.volume.samples > 0
+            && self.fog.is_some_and(|f| f.density > 0.0)
+            && self.lights.iter().any(|l| !matches!(l, Light::Directional { .. }))
+    }
+
+    /// True when the caustic passes have work: caustic rays are enabled, and
+    /// the scene has a light that emits them, a specular object and a diffuse
+    /// receiver.
+    pub fn needs_caustics(&self) -> bool {
+        let has = |pred: &dyn Fn(&Material) -> bool| self.objects.iter().any(|o| pred(&self.materials[o.material]));
+        self.caustics.rays > 0
+            && self.lights.iter().any(Light::emits_caustic_rays)
+            && has(&Material::is_specular)
+            && has(&|m| matches!(m.kind, MaterialKind::Diffuse))
     }
 }
 

@@ -69,6 +69,7 @@ fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String>
         let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12).push_next(&mut fas).push_next(&mut frq);
         unsafe { instance.get_physical_device_features2(pd, &mut f2) };
         let float64 = f2.features.shader_float64;
+        let int64 = f2.features.shader_int64;
         if f12.buffer_device_address == 0 {
             missing.push("bufferDeviceAddress".into());
         }
@@ -87,6 +88,13 @@ fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String>
         // The intersection re-bases rays near each object in f64.
         if float64 == 0 {
             missing.push("shaderFloat64".into());
+        }
+        // The caustic map adds irradiance with 64-bit integer atomics.
+        if int64 == 0 {
+            missing.push("shaderInt64".into());
+        }
+        if f12.shader_buffer_int64_atomics == 0 {
+            missing.push("shaderBufferInt64Atomics".into());
         }
     }
     let has_compute = unsafe { instance.get_physical_device_queue_family_properties(pd) }
@@ -152,15 +160,14 @@ impl Device {
         let mut supported12 = vk::PhysicalDeviceVulkan12Features::default();
         let mut supported = vk::PhysicalDeviceFeatures2::default().push_next(&mut supported12);
         unsafe { raw_instance.get_physical_device_features2(physical, &mut supported) };
-        let base_features = vk::PhysicalDeviceFeatures::default()
-            .shader_float64(true)
-            .shader_int64(supported.features.shader_int64 == vk::TRUE);
+        let base_features = vk::PhysicalDeviceFeatures::default().shader_float64(true).shader_int64(true);
 
         let mut f12 = vk::PhysicalDeviceVulkan12Features::default()
             .buffer_device_address(true)
             .scalar_block_layout(true)
             .shader_sampled_image_array_non_uniform_indexing(true)
-            .host_query_reset(supported12.host_query_reset == vk::TRUE);
+            .host_query_reset(supported12.host_query_reset == vk::TRUE)
+            .shader_buffer_int64_atomics(true);
         let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
         let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
         let mut features = vk::PhysicalDeviceFeatures2::default()

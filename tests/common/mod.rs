@@ -34,6 +34,21 @@ pub fn render_validated(scene: &Scene) -> quadray::passes::RenderOutput {
     out
 }
 
+/// Renders `scene` with `variant` on a fresh validated context; the same
+/// checks as [`render_validated`].
+pub fn render_variant_validated(
+    scene: &Scene,
+    variant: quadray::passes::RenderVariant,
+) -> quadray::passes::RenderOutput {
+    let ctx = context();
+    let counters = ctx.counters();
+    let out = quadray::render_scene_with(&ctx, scene, variant, &mut |_, _| {}).unwrap();
+    drop(ctx);
+    assert_no_validation_errors(&counters);
+    assert!(out.radiance.iter().flatten().all(|v| v.is_finite()), "non-finite pixel");
+    out
+}
+
 /// Statistics of every channel of every pixel against a value every pixel
 /// should have (furnace tests).
 pub struct UniformStats {
@@ -96,6 +111,8 @@ pub fn scene_with(objects: Vec<SceneObject>) -> Scene {
         textures: vec![],
         environment: None,
         fog: None,
+        caustics: Default::default(),
+        volume: Default::default(),
     }
 }
 
@@ -174,4 +191,47 @@ pub fn test_objects() -> Vec<SceneObject> {
             placement(DVec3::splat(1.2), DVec3::new(0.0, 0.0, 0.0), DVec3::new(-1.0, 0.2, -3.0)),
         ),
     ]
+}
+
+/// A scene file's render with the caustic and volume passes against the
+/// brute-force path tracer (both passes off).
+pub struct BruteForceComparison {
+    /// Brute force at `reference_spp`.
+    pub reference: quadray::passes::RenderOutput,
+    /// With the passes, at `spp`.
+    pub fast: quadray::passes::RenderOutput,
+    /// Brute force at `spp`.
+    pub brute: quadray::passes::RenderOutput,
+    /// FLIP of `fast` against `reference`.
+    pub flip_fast: f64,
+    /// FLIP of `brute` against `reference`.
+    pub flip_brute: f64,
+}
+
+/// Renders `scenes/tests/{name}.toml` three ways (see
+/// [`BruteForceComparison`]); with QUADRAY_TEST_IMAGES set to a folder,
+/// writes the three images there as `{name}_*.png`.
+pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> BruteForceComparison {
+    use quadray::passes::RenderVariant;
+    let path = format!("{}/scenes/tests/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let mut scene = quadray::scene::load_scene(std::path::Path::new(&path)).unwrap();
+    let brute_force = RenderVariant { caustics: false, volume: false, ..Default::default() };
+    scene.image.spp = reference_spp;
+    let reference = render_variant_validated(&scene, brute_force);
+    assert!(reference.caustics.is_none() && reference.volume_seconds.is_none());
+    // Other random numbers than the reference's (the same seed would make
+    // the first `spp` samples of the reference those of `brute`).
+    scene.image.spp = spp;
+    scene.image.seed = scene.image.seed.wrapping_add(1);
+    let fast = render_variant_validated(&scene, RenderVariant::default());
+    let brute = render_variant_validated(&scene, brute_force);
+    let flip_fast = quadray::metrics::flip_mean(&reference, &fast, 0.0).unwrap();
+    let flip_brute = quadray::metrics::flip_mean(&reference, &brute, 0.0).unwrap();
+    if let Ok(dir) = std::env::var("QUADRAY_TEST_IMAGES") {
+        let dir = std::path::Path::new(&dir);
+        for (kind, out) in [("reference", &reference), ("passes", &fast), ("brute", &brute)] {
+            quadray::output::write_png(out, 0.0, &dir.join(format!("{name}_{kind}.png"))).unwrap();
+        }
+    }
+    BruteForceComparison { reference, fast, brute, flip_fast, flip_brute }
 }

@@ -1,0 +1,44 @@
+// The per-frame parameters (host twin: GpuFrame in src/passes/gpu.rs), read
+// by the render pass and the passes that feed it (G-buffer, caustics).
+#ifndef FRAME_GLSL
+#define FRAME_GLSL
+
+#include "interface.glsl"
+#include "media.glsl"
+
+// Camera basis: ray direction = forward + x right + y up, x and y in [-1, 1].
+layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
+    vec3 eye;
+    vec3 forward;
+    vec3 right;
+    vec3 up;
+    vec3 background;
+    uint width;
+    uint height;
+    uint seed;
+    uint lightCount;
+    uint maxDepth;
+    uint envMap;      // texture index of the environment map, or NO_TEXTURE
+    uint envWidth;
+    uint envHeight;
+    float envScale;
+    Medium fog;       // outside the objects (density 0: none)
+} frame;
+
+// The direction through image position `pixel` (in pixels, y down).
+vec3 cameraRay(vec2 pixel) {
+    vec2 ndc = vec2(2.0 * pixel.x / float(frame.width) - 1.0, 1.0 - 2.0 * pixel.y / float(frame.height));
+    return normalize(frame.forward + ndc.x * frame.right + ndc.y * frame.up);
+}
+
+// The fog as a local value (copied field by field: glslang mis-types a
+// direct copy of structs between blocks of different layouts).
+Medium fogMedium() {
+    Medium m;
+    m.density = frame.fog.density;
+    m.albedo = frame.fog.albedo;
+    m.anisotropy = frame.fog.anisotropy;
+    return m;
+}
+
+#endif

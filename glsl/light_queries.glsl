@@ -1,0 +1,46 @@
+// Queries about the scene's lights that need the `lights` buffer and the
+// frame: which area light a ray meets first, whether a shadow ray reaches a
+// light, where a positional light is. Shared by the render and volume passes.
+#ifndef LIGHT_QUERIES_GLSL
+#define LIGHT_QUERIES_GLSL
+
+#include "lights.glsl"
+#include "frame.glsl"
+
+// The first area light other than `except` that o + t d meets before tmax:
+// its index (or frame.lightCount when none) and distance.
+uint firstLightHit(vec3 o, vec3 d, float tmax, uint except, out float tHit) {
+    uint which = frame.lightCount;
+    tHit = tmax;
+    for (uint i = 0; i < frame.lightCount; ++i) {
+        if (i == except) continue;
+        float t = lightHit(lights[i], o, d);
+        if (t < tHit) {
+            tHit = t;
+            which = i;
+        }
+    }
+    return which;
+}
+
+// True when nothing blocks the shadow ray from `origin` along wi over
+// `dist` toward light `i`: no geometry, and no other sphere or rect light in
+// front (lights are not in the acceleration structure, so they may hide
+// each other).
+bool lightVisible(vec3 origin, vec3 wi, float dist, uint i) {
+    if (occluded(origin, wi, 0.0, dist)) return false;
+    float tl;
+    return firstLightHit(origin, wi, dist, i, tl) == frame.lightCount;
+}
+
+// True for lights with a position (point, sphere, rect): the ones the
+// equiangular estimate aims at.
+bool positionalLight(uint i) { return i < frame.lightCount && lights[i].kind != LIGHT_DIRECTIONAL; }
+
+vec3 lightCentre(uint i) {
+    Light l = lights[i];
+    vec3 c = v3(l.position);
+    return l.kind == LIGHT_RECT ? c + 0.5 * (v3(l.edgeU) + v3(l.edgeV)) : c;
+}
+
+#endif

@@ -1,0 +1,312 @@
+//! The caustic passes (paper section 3), run before the render pass when the
+//! scene has a light that emits caustic rays, a specular object and a diffuse
+//! receiver ([`Scene::needs_caustics`]):
+//!
+//! 1. **G-buffer** (`gbuffer.comp`): the surface seen through each pixel
+//!    centre: where caustics can be seen.
+//! 2. **Caustic rays** (`caustic_trace.comp`): for each light (and each of
+//!    `light_samples` points on a sphere light), a grid of rays aimed at the
+//!    bounds of all specular objects together, traced through them until
+//!    they land on a diffuse surface.
+//! 3. **Caustic cells** (`caustic_splat.comp`): each 2x2 block of grid
+//!    neighbours that followed the same surfaces is a cell; its landing area
+//!    gives the irradiance, interpolated between its corners and added to
+//!    the pixels whose receiver lies in it (the caustic map).
+//!
+//! The render pass adds the caustic map at the primary diffuse vertex and
+//! leaves out the paths it covers.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::DVec3;
+
+use super::gpu::{GpuCausticRay, GpuEmitter, GpuReceiver};
+use super::scene_gpu::GpuScene;
+use crate::geometry::CellParams;
+use crate::scene::{Light, Scene};
+use crate::shader_interface::{CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP};
+use crate::vk::{full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::{shaders, RenderError};
+
+/// What the caustic passes did, and how long they took.
+#[derive(Clone, Debug, Default)]
+pub struct CausticReport {
+    /// Caustic rays traced (all grids).
+    pub rays: u64,
+    /// Rays that landed on a diffuse receiver after a specular vertex.
+    pub landed: u64,
+    /// Emission grids (lights × light samples).
+    pub grids: usize,
+    /// Wall time of the G-buffer pass (s).
+    pub gbuffer_seconds: f64,
+    /// Wall time of the caustic-ray pass (s).
+    pub trace_seconds: f64,
+    /// Wall time of the caustic-cell splat pass (s).
+    pub splat_seconds: f64,
+    /// Caustic irradiance per pixel (W/m², RGB) at the pixel-centre receiver.
+    pub irradiance: Vec<[f32; 3]>,
+}
+
+impl CausticReport {
+    /// Total wall time of the caustic passes (s).
+    pub fn seconds(&self) -> f64 {
+        self.gbuffer_seconds + self.trace_seconds + self.splat_seconds
+    }
+}
+
+/// The caustic passes' results that the render pass binds.
+pub struct CausticMap {
+    /// Receiver per pixel (`GpuReceiver`).
+    pub receivers: Buffer,
+    /// Fixed-point irradiance per pixel (three `u64`).
+    pub map: Buffer,
+    /// What was done.
+    pub report: CausticReport,
+}
+
+/// One grid per light and light sample, each aimed at the bounds of all the
+/// specular objects (one grid, so that no ray is counted twice where specular
+/// objects nest, like water in a glass vessel). Positions are relative to
+/// `origin` (the GPU frame's), computed in f64. `None` when a light sits inside those bounds
+/// (no grid plane in front of it can see them all).
+pub fn emitters(scene: &Scene, origin: DVec3, max_specular: u32) -> Option<Vec<GpuEmitter>> {
+    let corners: Vec<DVec3> = specular_corners(scene).into_iter().map(|c| c - origin).collect();
+    if corners.is_empty() {
+        return Some(Vec::new());
+    }
+    let centre_rel = corners.iter().fold(DVec3::ZERO, |a, &c| a + c) / corners.len() as f64;
+    let radius = corners.iter().map(|c| c.distance(centre_rel)).fold(0.0, f64::max);
+    let rays = scene.caustics.rays;
+    let mut out = Vec::new();
+    for light in scene.lights.iter().filter(|l| l.emits_caustic_rays()) {
+        match *light {
+            Light::Point { position, intensity } => {
+                out.push(point_grid(position - origin, intensity.as_dvec3(), &corners, centre_rel, rays)?);
+            }
+            Light::Sphere { centre: c, radius: r, radiance } => {
+                // A sphere of radiance L has intensity L π r² in every
+                // direction; the rays leave from points of its disk facing
+                // the targets, one grid per point.
+                let k = scene.caustics.light_samples.max(1);
+                let intensity = radiance.as_dvec3() * (std::f64::consts::PI * r * r / k as f64);
+                let w = (centre_rel + origin - c).normalize_or(DVec3::Z);
+                let (u, v) = w.any_orthonormal_pair();
+                for i in 0..k {
+                    // Fibonacci points over the disk (equal areas).
+                    let rho = r * ((i as f64 + 0.5) / k as f64).sqrt();
+                    let phi = i as f64 * 2.399_963_229_728_653;
+                    let p = c + rho * (phi.cos() * u + phi.sin() * v);
+                    out.push(point_grid(p - origin, intensity, &corners, centre_rel, rays)?);
+                }
+            }
+            Light::Directional { direction, irradiance } => {
+                out.push(parallel_grid(-direction, irradiance.as_dvec3(), &corners, centre_rel, radius, rays));
+            }
+            Light::Rect { .. } => {}
+        }
+    }
+    let mut first = 0u32;
+    for e in &mut out {
+        e.first_ray = first;
+        e.max_specular = max_specular;
+        first += e.grid[0] * e.grid[1];
+    }
+    Some(out)
+}
+
+/// World corners of the cells of every specular object.
+fn specular_corners(scene: &Scene) -> Vec<DVec3> {
+    let mut corners = Vec::new();
+    for object in scene.objects.iter().filter(|o| scene.materials[o.material].is_specular()) {
+        let Ok(cells) = object.shape.cells(&CellParams::default()) else { continue };
+        for cell in cells {
+            let (lo, hi) = (cell.bounds.min, cell.bounds.max);
+            for k in 0..8 {
+                let p = DVec3::new(
+                    if k & 1 == 0 { lo.x } else { hi.x },
+                    if k & 2 == 0 { lo.y } else { hi.y },
+                    if k & 4 == 0 { lo.z } else { hi.z },
+                );
+                corners.push(object.transform.transform_point3(p));
+            }
+        }
+    }
+    corners
+}
+
+/// Grid dimensions with about `rays` rays over a rectangle of `size`, with
+/// square grid cells.
+fn grid_for(size: glam::DVec2, rays: u32) -> [u32; 2] {
+    let aspect = (size.x / size.y.max(1e-30)).clamp(1e-3, 1e3);
+    let nx = ((rays as f64 * aspect).sqrt().round() as u32).max(2);
+    let ny = (rays / nx).max(2);
+    [nx, ny]
+}
+
+/// Rays from `p` over the tangent-plane rectangle (at distance 1 along the
+/// axis toward `centre`) that bounds `corners`; `None` when a corner is not
+/// in front of `p`.
+fn point_grid(p: DVec3, intensity: DVec3, corners: &[DVec3], centre: DVec3, rays: u32) -> Option<GpuEmitter> {
+    let w = (centre - p).normalize_or(DVec3::Z);
+    let (u, v) = w.any_orthonormal_pair();
+    let (mut lo, mut hi) = (glam::DVec2::splat(f64::MAX), glam::DVec2::splat(f64::MIN));
+    for &c in corners {
+        let r = c - p;
+        let z = r.dot(w);
+        if z <= 1e-6 * r.length() {
+            return None;
+        }
+        let xy = glam::DVec2::new(r.dot(u), r.dot(v)) / z;
+        lo = lo.min(xy);
+        hi = hi.max(xy);
+    }
+    Some(GpuEmitter {
+        origin: p.as_vec3().to_array(),
+        kind: EMITTER_POINT,
+        u: u.as_vec3().to_array(),
+        v: v.as_vec3().to_array(),
+        w: w.as_vec3().to_array(),
+        lo: lo.as_vec2().to_array(),
+        hi: hi.as_vec2().to_array(),
+        grid: grid_for(hi - lo, rays),
+        power: intensity.as_vec3().to_array(),
+        ..Default::default()
+    })
+}
+
+/// Parallel rays along `w` over the rectangle that bounds `corners` in the
+/// plane across `w`, starting well outside the bounds.
+fn parallel_grid(w: DVec3, irradiance: DVec3, corners: &[DVec3], centre: DVec3, radius: f64, rays: u32) -> GpuEmitter {
+    let w = w.normalize();
+    let (u, v) = w.any_orthonormal_pair();
+    let (mut lo, mut hi) = (glam::DVec2::splat(f64::MAX), glam::DVec2::splat(f64::MIN));
+    for &c in corners {
+        let xy = glam::DVec2::new((c - centre).dot(u), (c - centre).dot(v));
+        lo = lo.min(xy);
+        hi = hi.max(xy);
+    }
+    GpuEmitter {
+        origin: (centre - w * (2.0 * radius + 1.0)).as_vec3().to_array(),
+        kind: EMITTER_PARALLEL,
+        u: u.as_vec3().to_array(),
+        v: v.as_vec3().to_array(),
+        w: w.as_vec3().to_array(),
+        lo: lo.as_vec2().to_array(),
+        hi: hi.as_vec2().to_array(),
+        grid: grid_for(hi - lo, rays),
+        power: irradiance.as_vec3().to_array(),
+        ..Default::default()
+    }
+}
+
+/// The descriptor layout shared by the three caustic shaders.
+fn binding_kinds() -> Vec<BindingKind> {
+    let mut kinds = vec![BindingKind::AccelerationStructure];
+    kinds.extend([BindingKind::StorageBuffer; 10]);
+    kinds
+}
+
+impl CausticMap {
+    /// Runs the three passes for a `width` x `height` image whose frame
+    /// parameters are in `frame` (`GpuFrame`), with `grids` from [`emitters`].
+    pub fn compute(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        gpu: &GpuScene,
+        scene: &Scene,
+        frame: &Buffer,
+        (width, height): (u32, u32),
+        grids: &[GpuEmitter],
+    ) -> Result<Self, RenderError> {
+        let pixels = width as u64 * height as u64;
+        let ray_count: u64 = grids.iter().map(|g| g.grid[0] as u64 * g.grid[1] as u64).sum();
+        let rays = Buffer::new(
+            device,
+            "caustic rays",
+            ray_count.max(1) * std::mem::size_of::<GpuCausticRay>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let receivers = Buffer::new(
+            device,
+            "receivers",
+            pixels * std::mem::size_of::<GpuReceiver>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuOnly,
+        )?;
+        let map = Buffer::new(
+            device,
+            "caustic map",
+            pixels * 24,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let kinds = binding_kinds();
+        let specialisation = [crate::shader_interface::INTERSECT_FULL, 0, 0, u32::from(scene.has_media())];
+        let push = std::mem::size_of::<GpuEmitter>() as u32;
+        let gbuffer = ComputePipeline::new(device, &shaders::gbuffer(), &kinds, push, &specialisation)?;
+        let trace = ComputePipeline::new(device, &shaders::caustic_trace(), &kinds, push, &specialisation)?;
+        let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &kinds, push, &specialisation)?;
+        let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
+        let bindings = [
+            tlas,
+            objects,
+            cells,
+            perturbations,
+            lists,
+            Binding::Buffer(&gpu.materials),
+            Binding::Buffer(&gpu.lights),
+            Binding::Buffer(frame),
+            Binding::Buffer(&rays),
+            Binding::Buffer(&receivers),
+            Binding::Buffer(&map),
+        ];
+        for p in [&gbuffer, &trace, &splat] {
+            p.bind(&bindings);
+        }
+        let mut report = CausticReport { rays: ray_count, grids: grids.len(), ..Default::default() };
+
+        let start = Instant::now();
+        cmds.run(|d, cmd| {
+            unsafe { d.cmd_fill_buffer(cmd, map.raw, 0, vk::WHOLE_SIZE, 0) };
+            gbuffer.dispatch(
+                cmd,
+                bytemuck::bytes_of(&GpuEmitter::default()),
+                [width.div_ceil(RENDER_GROUP), height.div_ceil(RENDER_GROUP), 1],
+            );
+            full_barrier(d, cmd);
+        })?;
+        report.gbuffer_seconds = start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        cmds.run(|d, cmd| {
+            for g in grids {
+                trace.dispatch(cmd, bytemuck::bytes_of(g), [(g.grid[0] * g.grid[1]).div_ceil(CAUSTIC_GROUP), 1, 1]);
+            }
+            full_barrier(d, cmd);
+        })?;
+        report.trace_seconds = start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        cmds.run(|d, cmd| {
+            for g in grids {
+                let cells = (g.grid[0] - 1) * (g.grid[1] - 1);
+                splat.dispatch(cmd, bytemuck::bytes_of(g), [cells.div_ceil(CAUSTIC_GROUP), 1, 1]);
+            }
+            full_barrier(d, cmd);
+        })?;
+        report.splat_seconds = start.elapsed().as_secs_f64();
+
+        let landed: Vec<GpuCausticRay> = rays.read();
+        report.landed = landed.iter().take(ray_count as usize).filter(|r| r.path != 0).count() as u64;
+        let fixed: Vec<u64> = map.read();
+        let scale = 1.0 / CAUSTIC_FIXED_POINT as f64;
+        report.irradiance = fixed
+            .chunks_exact(3)
+            .take(pixels as usize)
+            .map(|c| [(c[0] as f64 * scale) as f32, (c[1] as f64 * scale) as f32, (c[2] as f64 * scale) as f32])
+            .collect();
+        Ok(Self { receivers, map, report })
+    }
+}

@@ -1,0 +1,116 @@
+//! The caustic passes against closed forms and against the brute-force path
+//! tracer:
+//!
+//! - Energy: a point light above a glass ball over a floor. The caustic map,
+//!   integrated over the floor, holds the flux that enters the ball and
+//!   leaves it toward the floor: ∫ I (1 − F(θ))² dω over the ball's cone of
+//!   directions (both interfaces see the same angle θ in a ball, and the
+//!   caustic rays follow refraction only).
+//! - Lens over a plane (`scenes/tests/lens.toml`): the render with the
+//!   caustic passes against a long brute-force render (FLIP).
+//! - A scene without specular objects runs no caustic pass.
+
+mod common;
+
+use quadray::passes::RenderVariant;
+use quadray::scene::parse_scene;
+
+/// Relative error allowed on the deposited flux: the grid's boundary rays
+/// deposit part of their flux (about 1 / (rays across the ball)), and the
+/// pixels integrate the map by the midpoint rule.
+const FLUX_TOLERANCE: f64 = 0.02;
+
+/// Unpolarised Fresnel reflectance at a smooth interface (f64), `eta` = n_t / n_i.
+fn fresnel(cos_i: f64, eta: f64) -> f64 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (r_par * r_par + r_perp * r_perp)
+}
+
+/// Flux through a ball of radius `r` at distance `d` from a point light of
+/// intensity `intensity` after two refractions: ∫ I (1 − F)² dω over the
+/// cone, the incidence angle from the impact parameter d sin ψ.
+fn predicted_flux(intensity: f64, d: f64, r: f64, eta: f64) -> f64 {
+    let psi_max = (r / d).asin();
+    let steps = 200_000;
+    let h = psi_max / steps as f64;
+    (0..steps)
+        .map(|k| {
+            let psi = (k as f64 + 0.5) * h;
+            let sin_i = (d * psi.sin() / r).min(1.0);
+            let t = 1.0 - fresnel((1.0 - sin_i * sin_i).sqrt(), eta);
+            intensity * t * t * 2.0 * std::f64::consts::PI * psi.sin() * h
+        })
+        .sum()
+}
+
+#[test]
+fn glass_ball_deposits_the_flux_fresnel_predicts() {
+    // The camera looks up at the floor from below: the floor is two-sided,
+    // so every pixel's receiver is a floor point, and none is hidden by the
+    // ball. Each pixel covers the same floor area (the image plane is
+    // parallel to the floor).
+    let (height, fov, size) = (3.0, 120.0f64, 320u32);
+    let scene = parse_scene(
+        &format!(
+            "background = [0, 0, 0]\n\
+             [image]\nwidth = {size}\nheight = {size}\nspp = 1\nmax_depth = 6\n\
+             [caustics]\nrays = 262144\n\
+             [camera]\nposition = [0, -{height}, 0]\nlook_at = [0, 0, 0]\nup = [0, 0, 1]\nfov = {fov}\n\
+             [[materials]]\nname = \"floor\"\nalbedo = [0.5, 0.5, 0.5]\n\
+             [[materials]]\nname = \"glass\"\ntype = \"dielectric\"\nior = 1.5\n\
+             [[objects]]\nmaterial = \"floor\"\nplane = {{}}\nclip = {{ min = [-12, -0.01, -12], max = [12, 0.01, 12] }}\n\
+             [[objects]]\nmaterial = \"glass\"\nsphere = {{ radius = 0.5 }}\ntranslate = [0, 2, 0]\n\
+             [[lights]]\ntype = \"point\"\nposition = [0, 6, 0]\nintensity = [100, 100, 100]\n"
+        ),
+        "energy.toml",
+    )
+    .unwrap();
+    let out = common::render_variant_validated(&scene, RenderVariant::default());
+    let report = out.caustics.as_ref().expect("the caustic passes ran");
+    let half = height * (0.5 * fov).to_radians().tan();
+    let pixel_area = (2.0 * half / size as f64).powi(2);
+    let deposited: f64 = report.irradiance.iter().map(|e| e[0] as f64 * pixel_area).sum();
+    let predicted = predicted_flux(100.0, 4.0, 0.5, 1.5);
+    let error = (deposited - predicted).abs() / predicted;
+    println!(
+        "glass ball: {} rays, {} landed; deposited flux {deposited:.5} W, predicted {predicted:.5} W, \
+         relative error {error:.4} (bound {FLUX_TOLERANCE})",
+        report.rays, report.landed
+    );
+    assert!(error < FLUX_TOLERANCE);
+}
+
+/// FLIP between the lens scene with the caustic passes and a long
+/// brute-force render.
+const LENS_FLIP_BOUND: f64 = 0.05;
+
+#[test]
+fn lens_over_plane_matches_the_brute_force_path_tracer() {
+    let c = common::compare_with_brute_force("lens", 4096, 64);
+    let report = c.fast.caustics.as_ref().expect("the caustic passes ran");
+    println!(
+        "lens: FLIP against brute force at 4096 spp: caustic passes at 64 spp {:.4} (bound {LENS_FLIP_BOUND}), \
+         brute force at 64 spp {:.4}; caustic passes {:.3} s for {} rays",
+        c.flip_fast,
+        c.flip_brute,
+        report.seconds(),
+        report.rays
+    );
+    assert!(c.flip_fast < LENS_FLIP_BOUND);
+}
+
+#[test]
+fn scenes_without_specular_objects_run_no_caustic_pass() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/tests/one_sphere.toml");
+    let scene = quadray::scene::load_scene(std::path::Path::new(path)).unwrap();
+    assert!(!scene.needs_caustics());
+    let out = common::render_variant_validated(&scene, RenderVariant::default());
+    assert!(out.caustics.is_none(), "caustic passes ran");
+    println!("one_sphere: no caustic pass ran (0 s in caustic passes)");
+}
