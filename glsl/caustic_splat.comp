@@ -65,16 +65,6 @@ vec3 rayIrradiance(ivec2 g) {
     return area > 0.0 ? v3(rayAt(g).flux) * (cells / area) : vec3(0.0);
 }
 
-// Image position (pixels, y down) of p; false behind the camera.
-bool project(vec3 p, out vec2 pixel) {
-    vec3 r = p - frame.eye;
-    float z = dot(r, frame.forward) / dot(frame.forward, frame.forward);
-    if (z <= 0.0) return false;
-    vec2 ndc = vec2(dot(r, frame.right) / dot(frame.right, frame.right), dot(r, frame.up) / dot(frame.up, frame.up)) / z;
-    pixel = vec2((ndc.x + 1.0) * 0.5 * float(frame.width), (1.0 - ndc.y) * 0.5 * float(frame.height));
-    return true;
-}
-
 // Barycentric coordinates of x in triangle (a, b, c), and x's distance from
 // its plane in w; w < 0 for a degenerate triangle.
 vec4 barycentric(vec3 x, vec3 a, vec3 b, vec3 c) {

@@ -58,6 +58,8 @@ void main() {
     ray.object = NO_HIT;
     ray.flux = float[3](0.0, 0.0, 0.0);
     ray.path = 0u;
+    ray.beamStart = float[3](0.0, 0.0, 0.0);
+    ray.inFog = 0u;
     MediaStack media = emptyStack();
     uint path = 2166136261u;
     uint speculars = 0u;
@@ -77,6 +79,8 @@ void main() {
                 ray.object = h.object;
                 ray.flux = float[3](flux.x, flux.y, flux.z);
                 ray.path = max(extendPath(path, h.object), 1u);
+                ray.beamStart = float[3](o.x, o.y, o.z);
+                ray.inFog = MEDIA_ENABLED != 0u && media.count == 0u && frame.fog.density > 0.0 ? 1u : 0u;
             }
             break;
         }

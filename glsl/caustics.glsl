@@ -10,8 +10,8 @@
 
 #include "interface.glsl"
 
-// Caustic irradiance (fixed point, one 64-bit integer per channel) as RGB.
-#define CAUSTIC_IRRADIANCE(map, pixel) \
+// A fixed-point RGB value of the caustic or beam map (one 64-bit integer per channel).
+#define FIXED_POINT_RGB(map, pixel) \
     (vec3(float(map[3u * (pixel)]), float(map[3u * (pixel) + 1u]), float(map[3u * (pixel) + 2u])) \
      / float(CAUSTIC_FIXED_POINT))
 
@@ -23,6 +23,8 @@ struct CausticRay {
     uint object;
     float flux[3];     // watts carried by the ray when it lands
     uint path;
+    float beamStart[3];  // where its last segment began (its last specular vertex)
+    uint inFog;          // 1 when that segment runs through the fog
 };
 
 // The first surface seen through a pixel's centre.

@@ -31,6 +31,16 @@ vec3 cameraRay(vec2 pixel) {
     return normalize(frame.forward + ndc.x * frame.right + ndc.y * frame.up);
 }
 
+// Image position (pixels, y down) of p; false behind the camera.
+bool project(vec3 p, out vec2 pixel) {
+    vec3 r = p - frame.eye;
+    float z = dot(r, frame.forward) / dot(frame.forward, frame.forward);
+    if (z <= 0.0) return false;
+    vec2 ndc = vec2(dot(r, frame.right) / dot(frame.right, frame.right), dot(r, frame.up) / dot(frame.up, frame.up)) / z;
+    pixel = vec2((ndc.x + 1.0) * 0.5 * float(frame.width), (1.0 - ndc.y) * 0.5 * float(frame.height));
+    return true;
+}
+
 // The fog as a local value (copied field by field: glslang mis-types a
 // direct copy of structs between blocks of different layouts).
 Medium fogMedium() {

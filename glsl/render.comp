@@ -51,12 +51,20 @@ layout(constant_id = 4) const uint CAUSTICS_ENABLED = 0u;
 // this out.
 layout(constant_id = 5) const uint VOLUME_ENABLED = 0u;
 
+// Specialisation constant: 1 when the caustic beam pass ran (caustics in
+// fog): the camera ray's first segment gets the volumetric caustics from the
+// beam map, and a path that scatters on it and reaches a sphere light
+// through the specular vertices the caustic rays follow is left out.
+layout(constant_id = 6) const uint BEAMS_ENABLED = 0u;
+
 // In-scattered radiance per pixel from the volume pass (volume.comp).
 layout(set = 0, binding = BINDING_RENDER_VOLUME, scalar) readonly buffer Volume { float volume[]; };
 
 #include "caustics.glsl"
 layout(set = 0, binding = BINDING_RENDER_GBUFFER, scalar) readonly buffer Receivers { Receiver receivers[]; };
 layout(set = 0, binding = BINDING_RENDER_CAUSTICS, scalar) readonly buffer CausticMap { uint64_t causticMap[]; };
+// Volumetric-caustic radiance per pixel (caustic_beams.comp), fixed point.
+layout(set = 0, binding = BINDING_RENDER_BEAMS, scalar) readonly buffer BeamMap { uint64_t beamMap[]; };
 
 // Specialisation constant: FILTER_NONE, FILTER_RAY_CONES or FILTER_COVARIANCE.
 layout(constant_id = 2) const uint FILTER_MODE = FILTER_NONE;
@@ -355,6 +363,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         // scattering toward positional lights.
         bool volumeSegment = VOLUME_ENABLED != 0u && step == 0u;
         if (volumeSegment) radiance += vec3(volume[3u * pixel], volume[3u * pixel + 1u], volume[3u * pixel + 2u]);
+        if (BEAMS_ENABLED != 0u && step == 0u) radiance += FIXED_POINT_RGB(beamMap, pixel);
         bool afterVolumeScatter = scatteredOnVolumeSegment;
         scatteredOnVolumeSegment = false;
         float tl;
@@ -405,7 +414,10 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 }
                 d = wi;
                 o = p;
-                causticPath = false;
+                // A scattering event on the camera ray's first segment is a
+                // receiver of the beam map's volumetric caustics.
+                causticPath = BEAMS_ENABLED != 0u && step == 0u;
+                causticSpeculars = 0u;
                 scatteredOnVolumeSegment = volumeSegment;
                 if (!survives(throughput, bounce, rng)) break;
                 ++bounce;
@@ -473,7 +485,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         bool last = bounce + 1u == frame.maxDepth;
         bool primaryReceiver = CAUSTICS_ENABLED != 0u && bounce == 0u && mat.kind == MATERIAL_DIFFUSE
             && receivers[pixel].object == h.object;
-        if (primaryReceiver) radiance += throughput * v3(mat.albedo) / PI * CAUSTIC_IRRADIANCE(causticMap, pixel);
+        if (primaryReceiver) radiance += throughput * v3(mat.albedo) / PI * FIXED_POINT_RGB(causticMap, pixel);
         if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, med, !last, rng);
         if (last) break;
 

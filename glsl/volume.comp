@@ -3,11 +3,13 @@
 // the fog toward the camera from each positional light (point, sphere,
 // rect), with shadows: light shafts. For each pixel, camera rays jittered
 // over the pixel run from the camera to the first surface (or to a sphere or
-// rect light in front of it, or on to infinity); on each, one point per
-// light by equiangular sampling (media.glsl: its density follows the
-// light's 1/r², so the noise does not grow near a bright light, unlike
-// distance sampling), a point on the light by the light's sampler, and a
-// shadow ray through the ray queries. The render pass adds the pixel's mean
+// rect light in front of it, or on to infinity); on each, per light, one
+// point by equiangular sampling (media.glsl: its density follows the
+// light's 1/r², so the noise does not grow near a small bright light,
+// unlike distance sampling) and one by distance sampling (for large lights),
+// weighted by multiple importance sampling; at each, a direction toward the
+// light and one from the phase function (again weighted by multiple
+// importance sampling), each with a shadow ray through the ray queries. The render pass adds the pixel's mean
 // on the camera ray's first segment and leaves single scattering toward
 // positional lights there out of its own estimate.
 #extension GL_EXT_nonuniform_qualifier : require
@@ -33,20 +35,56 @@ layout(push_constant, scalar) uniform Push {
     uint total;        // camera rays per pixel over all dispatches
 } pc;
 
-// Single scattering toward light i along the fog segment o + t d, t < tEnd:
-// σ_s p T(t) T(light) L / (pdf of the point × pdf of the light sample).
+// The light from light i scattered at o + t d toward the camera, before the
+// point's density: σ_s T(t) × the in-scattered radiance, whose direction
+// integral is estimated by multiple importance sampling (power heuristic)
+// of a direction toward the light (the light's sampler) and one from the
+// phase function (area lights only; they also find the parts of a large
+// light that its sampler reaches at grazing angles, with high variance).
+vec3 scatteredAt(Medium fog, vec3 o, vec3 d, float t, uint i, inout uint rng) {
+    vec3 x = o + t * d;
+    vec3 sum = vec3(0.0);
+    LightSample ls = sampleLight(lights[i], x, rand2(rng));
+    if (ls.valid && lightVisible(x, ls.wi, ls.dist, i)) {
+        float phase = hgPdf(fog.anisotropy, dot(d, ls.wi));
+        vec3 f = transmittance(fog, ls.dist) * phase * ls.radiance;
+        sum += ls.pdf == 0.0 ? f : f * (powerHeuristic(ls.pdf, phase) / ls.pdf);
+    }
+    if (lights[i].kind == LIGHT_SPHERE || lights[i].kind == LIGHT_RECT) {
+        vec3 wi = sampleHg(fog.anisotropy, d, rand2(rng));
+        float tl = lightHit(lights[i], x, wi);
+        if (tl != NO_ROOT && lightVisible(x, wi, tl, i)) {
+            // The phase function's sample weighs phase / pdf = 1.
+            float phase = hgPdf(fog.anisotropy, dot(d, wi));
+            float w = powerHeuristic(phase, lightPdf(lights[i], x, wi));
+            sum += transmittance(fog, tl) * w * v3(lights[i].color);
+        }
+    }
+    return sum * (exp(-fog.density * t) * fog.density) * v3(fog.albedo);
+}
+
+// Single scattering toward light i along the fog segment o + t d, t < tEnd,
+// from two points combined by multiple importance sampling (power
+// heuristic): one by equiangular sampling toward the light's centre (best
+// for small lights: it follows their 1/r²) and one by distance sampling,
+// density σ_t T(t) (best for large lights such as a lit wall, whose
+// contribution along the ray is nearly flat).
 vec3 inScattered(Medium fog, vec3 o, vec3 d, float tEnd, uint i, inout uint rng) {
     Equiangular e = equiangularSetup(o, d, tEnd, lightCentre(i));
-    float t = equiangularSample(e, rand(rng));
-    float pt = equiangularPdf(e, t);
-    if (!(t >= 0.0 && t < tEnd) || !(pt > 0.0)) return vec3(0.0);
-    vec3 x = o + t * d;
-    LightSample ls = sampleLight(lights[i], x, rand2(rng));
-    if (!ls.valid || !lightVisible(x, ls.wi, ls.dist, i)) return vec3(0.0);
-    float phase = hgPdf(fog.anisotropy, dot(d, ls.wi));
-    vec3 f = (exp(-fog.density * t) * transmittance(fog, ls.dist) * fog.density * phase) * v3(fog.albedo)
-        * ls.radiance;
-    return f / (pt * (ls.pdf == 0.0 ? 1.0 : ls.pdf));
+    vec3 sum = vec3(0.0);
+    float te = equiangularSample(e, rand(rng));
+    float pe = equiangularPdf(e, te);
+    if (te >= 0.0 && te < tEnd && pe > 0.0) {
+        float pd = fog.density * exp(-fog.density * te);
+        sum += scatteredAt(fog, o, d, te, i, rng) * (powerHeuristic(pe, pd) / pe);
+    }
+    float td = -log(1.0 - rand(rng)) / fog.density;
+    if (td < tEnd) {
+        float pd = fog.density * exp(-fog.density * td);
+        float pe2 = equiangularPdf(e, td);
+        if (pd > 0.0) sum += scatteredAt(fog, o, d, td, i, rng) * (powerHeuristic(pd, pe2) / pd);
+    }
+    return sum;
 }
 
 void main() {

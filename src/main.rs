@@ -390,7 +390,47 @@ fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> Result<quadr
     for (name, seconds, rate) in &rows {
         eprintln!("{name:<46} {seconds:>9.3} {rate:>14.0} {:>11.1}%", 100.0 * seconds / full_seconds);
     }
-    Ok(full.expect("the full render"))
+    let full = full.expect("the full render");
+    print_frame_table(&full, rows[2].1, im.spp);
+    Ok(full)
+}
+
+/// Per-pass times of one frame in the layout of the paper's table 1: a
+/// frame is one sample per pixel plus the caustic passes as configured.
+/// Geometry is the render without shading (camera rays and first-hit
+/// albedo), shading the rest of the render pass.
+fn print_frame_table(full: &quadray::passes::RenderOutput, geometry_seconds: f64, spp: u32) {
+    let ms = |s: f64| 1e3 * s;
+    let spp = spp.max(1) as f64;
+    let caustics = full.caustics.as_ref().map_or(0.0, |c| c.seconds());
+    let volume = full.volume_seconds.unwrap_or(0.0);
+    let render_pass = (full.seconds - caustics - volume) / spp;
+    let geometry = geometry_seconds / spp;
+    let shading = (render_pass - geometry).max(0.0);
+    let frame = render_pass + volume / spp + caustics;
+    eprintln!("\nOne frame (1 spp plus the caustic passes), as in the paper's table 1:");
+    eprintln!("| geometry (ms) | shading (ms) | caustic rays | caustics (ms) | volume (ms) | frame (ms) | frames/s |");
+    eprintln!("|---:|---:|---:|---:|---:|---:|---:|");
+    eprintln!(
+        "| {:.2} | {:.2} | {} | {:.2} | {:.2} | {:.2} | {:.3} |",
+        ms(geometry),
+        ms(shading),
+        full.caustics.as_ref().map_or(0, |c| c.rays),
+        ms(caustics),
+        ms(volume / spp),
+        ms(frame),
+        1.0 / frame
+    );
+    if let Some(c) = &full.caustics {
+        eprintln!(
+            "caustic passes: G-buffer {:.2} ms, rays {:.2} ms, cells {:.2} ms; {} of {} rays landed on a receiver",
+            ms(c.gbuffer_seconds),
+            ms(c.trace_seconds),
+            ms(c.splat_seconds),
+            c.landed,
+            c.rays
+        );
+    }
 }
 
 fn filter_bench(args: FilterBenchArgs) -> Result<()> {

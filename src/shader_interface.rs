@@ -114,3 +114,11 @@ pub const CAUSTIC_FIXED_POINT: u32 = 1048576;
 pub const BINDING_VOLUME: u32 = 8;
 /// Descriptor binding of the in-scattered radiance per pixel (render pass).
 pub const BINDING_RENDER_VOLUME: u32 = 14;
+/// Descriptor binding of the volumetric-caustic radiance buffer (caustic passes).
+pub const BINDING_CAUSTIC_BEAMS: u32 = 11;
+/// Descriptor binding of the volumetric-caustic radiance buffer (render pass).
+pub const BINDING_RENDER_BEAMS: u32 = 15;
+/// Grid rays between the corners of a caustic beam (volumetric caustics use
+/// coarser cells than surface caustics: a beam's cost grows with its size
+/// on screen).
+pub const BEAM_STRIDE: u32 = 8;

@@ -47,3 +47,9 @@ pub fn caustic_splat() -> Vec<u32> {
 pub fn volume() -> Vec<u32> {
     words(include_bytes!(concat!(env!("OUT_DIR"), "/volume.comp.spv")))
 }
+
+/// `glsl/caustic_beams.comp`: volumetric caustics from the caustic rays' last
+/// segments through the fog.
+pub fn caustic_beams() -> Vec<u32> {
+    words(include_bytes!(concat!(env!("OUT_DIR"), "/caustic_beams.comp.spv")))
+}

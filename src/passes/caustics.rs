@@ -12,9 +12,13 @@
 //!    neighbours that followed the same surfaces is a cell; its landing area
 //!    gives the irradiance, interpolated between its corners and added to
 //!    the pixels whose receiver lies in it (the caustic map).
+//! 4. **Caustic beams** (`caustic_beams.comp`, with fog only): coarser cells
+//!    of the rays' last segments through the fog scatter light toward the
+//!    camera (volumetric caustics, the beam map).
 //!
 //! The render pass adds the caustic map at the primary diffuse vertex and
-//! leaves out the paths it covers.
+//! the beam map on the camera ray's first segment, and leaves out the paths
+//! they cover.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -25,7 +29,9 @@ use super::gpu::{GpuCausticRay, GpuEmitter, GpuReceiver};
 use super::scene_gpu::GpuScene;
 use crate::geometry::CellParams;
 use crate::scene::{Light, Scene};
-use crate::shader_interface::{CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP};
+use crate::shader_interface::{
+    BEAM_STRIDE, CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP,
+};
 use crate::vk::{full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
 use crate::{shaders, RenderError};
 
@@ -44,6 +50,8 @@ pub struct CausticReport {
     pub trace_seconds: f64,
     /// Wall time of the caustic-cell splat pass (s).
     pub splat_seconds: f64,
+    /// Wall time of the volumetric-caustic (beam) pass (s); 0 without fog.
+    pub beam_seconds: f64,
     /// Caustic irradiance per pixel (W/m², RGB) at the pixel-centre receiver.
     pub irradiance: Vec<[f32; 3]>,
 }
@@ -51,7 +59,7 @@ pub struct CausticReport {
 impl CausticReport {
     /// Total wall time of the caustic passes (s).
     pub fn seconds(&self) -> f64 {
-        self.gbuffer_seconds + self.trace_seconds + self.splat_seconds
+        self.gbuffer_seconds + self.trace_seconds + self.splat_seconds + self.beam_seconds
     }
 }
 
@@ -61,6 +69,10 @@ pub struct CausticMap {
     pub receivers: Buffer,
     /// Fixed-point irradiance per pixel (three `u64`).
     pub map: Buffer,
+    /// Fixed-point radiance of the volumetric caustics per pixel (three `u64`).
+    pub beams: Buffer,
+    /// True when the beam pass ran (the scene has fog).
+    pub has_beams: bool,
     /// What was done.
     pub report: CausticReport,
 }
@@ -203,7 +215,7 @@ fn parallel_grid(w: DVec3, irradiance: DVec3, corners: &[DVec3], centre: DVec3, 
 /// The descriptor layout shared by the three caustic shaders.
 fn binding_kinds() -> Vec<BindingKind> {
     let mut kinds = vec![BindingKind::AccelerationStructure];
-    kinds.extend([BindingKind::StorageBuffer; 10]);
+    kinds.extend([BindingKind::StorageBuffer; 11]);
     kinds
 }
 
@@ -242,12 +254,21 @@ impl CausticMap {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
+        let beams = Buffer::new(
+            device,
+            "beam map",
+            pixels * 24,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
         let kinds = binding_kinds();
         let specialisation = [crate::shader_interface::INTERSECT_FULL, 0, 0, u32::from(scene.has_media())];
         let push = std::mem::size_of::<GpuEmitter>() as u32;
         let gbuffer = ComputePipeline::new(device, &shaders::gbuffer(), &kinds, push, &specialisation)?;
         let trace = ComputePipeline::new(device, &shaders::caustic_trace(), &kinds, push, &specialisation)?;
         let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &kinds, push, &specialisation)?;
+        let beam = ComputePipeline::new(device, &shaders::caustic_beams(), &kinds, push, &specialisation)?;
         let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
         let bindings = [
             tlas,
@@ -261,15 +282,20 @@ impl CausticMap {
             Binding::Buffer(&rays),
             Binding::Buffer(&receivers),
             Binding::Buffer(&map),
+            Binding::Buffer(&beams),
         ];
-        for p in [&gbuffer, &trace, &splat] {
+        for p in [&gbuffer, &trace, &splat, &beam] {
             p.bind(&bindings);
         }
         let mut report = CausticReport { rays: ray_count, grids: grids.len(), ..Default::default() };
 
         let start = Instant::now();
         cmds.run(|d, cmd| {
-            unsafe { d.cmd_fill_buffer(cmd, map.raw, 0, vk::WHOLE_SIZE, 0) };
+            unsafe {
+                d.cmd_fill_buffer(cmd, map.raw, 0, vk::WHOLE_SIZE, 0);
+                d.cmd_fill_buffer(cmd, beams.raw, 0, vk::WHOLE_SIZE, 0);
+            }
+            full_barrier(d, cmd);
             gbuffer.dispatch(
                 cmd,
                 bytemuck::bytes_of(&GpuEmitter::default()),
@@ -298,6 +324,18 @@ impl CausticMap {
         })?;
         report.splat_seconds = start.elapsed().as_secs_f64();
 
+        if has_beams {
+            let start = Instant::now();
+            cmds.run(|d, cmd| {
+                for g in grids {
+                    let count = ((g.grid[0] - 1) / BEAM_STRIDE) * ((g.grid[1] - 1) / BEAM_STRIDE);
+                    beam.dispatch(cmd, bytemuck::bytes_of(g), [count.div_ceil(CAUSTIC_GROUP).max(1), 1, 1]);
+                }
+                full_barrier(d, cmd);
+            })?;
+            report.beam_seconds = start.elapsed().as_secs_f64();
+        }
+
         let landed: Vec<GpuCausticRay> = rays.read();
         report.landed = landed.iter().take(ray_count as usize).filter(|r| r.path != 0).count() as u64;
         let fixed: Vec<u64> = map.read();
@@ -307,6 +345,6 @@ impl CausticMap {
             .take(pixels as usize)
             .map(|c| [(c[0] as f64 * scale) as f32, (c[1] as f64 * scale) as f32, (c[2] as f64 * scale) as f32])
             .collect();
-        Ok(Self { receivers, map, report })
+        Ok(Self { receivers, map, beams, has_beams, report })
     }
 }

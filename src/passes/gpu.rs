@@ -439,6 +439,10 @@ pub struct GpuCausticRay {
     pub flux: [f32; 3],
     /// Identifier of the sequence of surfaces; 0 marks an invalid ray.
     pub path: u32,
+    /// Start of the ray's last segment (its last specular vertex).
+    pub beam_start: [f32; 3],
+    /// 1 when the last segment runs through the fog.
+    pub in_fog: u32,
 }
 
 /// `Receiver` in caustics.glsl: the first surface through a pixel's centre.
@@ -484,7 +488,7 @@ pub struct GpuEmitter {
 }
 
 const _: () = {
-    assert!(std::mem::size_of::<GpuCausticRay>() == 32);
+    assert!(std::mem::size_of::<GpuCausticRay>() == 48);
     assert!(std::mem::size_of::<GpuReceiver>() == 16);
     assert!(std::mem::size_of::<GpuEmitter>() == 100);
     assert!(std::mem::size_of::<GpuQuadric>() == 40);

@@ -109,6 +109,7 @@ pub fn render(
     };
     let receivers = caustics.as_ref().map_or_else(|| receivers_placeholder.as_ref().unwrap(), |c| &c.receivers);
     let caustic_map = caustics.as_ref().map_or_else(|| map_placeholder.as_ref().unwrap(), |c| &c.map);
+    let beam_map = caustics.as_ref().map_or_else(|| map_placeholder.as_ref().unwrap(), |c| &c.beams);
     let volume = if variant.volume && variant.shading == SHADING_FULL && scene.needs_volume() {
         Some(VolumeLight::compute(
             device,
@@ -158,6 +159,7 @@ pub fn render(
         BindingKind::StorageBuffer,
         BindingKind::StorageBuffer,
         BindingKind::StorageBuffer,
+        BindingKind::StorageBuffer,
     ]);
     let pipeline = ComputePipeline::new(
         device,
@@ -171,6 +173,7 @@ pub fn render(
             u32::from(scene.has_media()),
             u32::from(caustics.is_some()),
             u32::from(volume.is_some()),
+            u32::from(caustics.as_ref().is_some_and(|c| c.has_beams)),
         ],
     )?;
     let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
@@ -190,6 +193,7 @@ pub fn render(
         Binding::Buffer(receivers),
         Binding::Buffer(caustic_map),
         Binding::Buffer(volume_radiance),
+        Binding::Buffer(beam_map),
     ]);
 
     let tiles: Vec<[u32; 4]> = (0..height)
