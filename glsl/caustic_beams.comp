@@ -95,8 +95,12 @@ void main() {
             if (t <= 0.0 || t >= tMax || s <= 0.0 || s >= len) continue;
             float delta = length(frame.eye + t * v - (s0 + s * u));
             float rootA = mix(rootA0, rootA1, s / len);
-            float area = rootA * rootA;
-            float rho2 = area / PI;
+            // A beam narrower than a pixel is widened to 1.5 pixels (its
+            // flux spread over the wider tube): sampled at pixel centres, a
+            // thinner one would alias into isolated bright dots.
+            float pixelWidth = t * 2.0 * length(frame.up) / float(frame.height);
+            float rho2 = max(rootA * rootA / PI, 0.5625 * pixelWidth * pixelWidth);
+            float area = PI * rho2;
             if (!(delta * delta < rho2)) continue;
             float chord = 2.0 * sqrt(rho2 - delta * delta) / sqrt(denom);
             // The flux was measured where the rays landed; upstream it had

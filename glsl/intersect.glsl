@@ -168,8 +168,14 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
             if (!overflow || attempt == 7) break;
             segHi = 0.5 * (segLo + segHi);
         }
+        // With the whole list, the rest of the segment is searched at once
+        // (halving further would gain nothing, and 64 splits of 1/128 each
+        // would leave most of a long segment unsearched).
         bool all = overflow;
-        if (all) nrel = cell.count;
+        if (all) {
+            nrel = cell.count;
+            segHi = s1;
+        }
 
         // Walk the pieces of [segLo, segHi] between the breakpoints; on each,
         // F' is a polynomial of degree <= 6, expanded around the piece's own

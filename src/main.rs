@@ -28,6 +28,20 @@ enum Command {
     /// Markdown and PNG plots), the time each mode takes to reach the error
     /// of `none` at the largest spp, and temporal stability over a camera pan.
     FilterBench(FilterBenchArgs),
+    /// Compare a render with a reference: FLIP (mean, from nv-flip) and
+    /// relative MSE between two EXR files of the same size.
+    Compare(CompareArgs),
+}
+
+#[derive(Parser, Debug)]
+struct CompareArgs {
+    /// The reference image (EXR).
+    reference: PathBuf,
+    /// The image to compare with it (EXR).
+    test: PathBuf,
+    /// Exposure in stops applied to both before FLIP's tone mapping.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
 }
 
 #[derive(Parser, Debug)]
@@ -300,14 +314,15 @@ fn render(args: RenderArgs) -> Result<()> {
     write_outputs(&out, &files)?;
     if let Some(c) = &out.caustics {
         eprintln!(
-            "caustics: {} rays in {} grid(s), {} landed on a receiver; {:.3} s (G-buffer {:.3}, rays {:.3}, cells {:.3})",
+            "caustics: {} rays in {} grid(s), {} landed on a receiver; {:.3} s (G-buffer {:.3}, rays {:.3}, cells {:.3}, beams {:.3})",
             c.rays,
             c.grids,
             c.landed,
             c.seconds(),
             c.gbuffer_seconds,
             c.trace_seconds,
-            c.splat_seconds
+            c.splat_seconds,
+            c.beam_seconds
         );
     }
     if let Some(v) = out.volume_seconds {
@@ -423,14 +438,66 @@ fn print_frame_table(full: &quadray::passes::RenderOutput, geometry_seconds: f64
     );
     if let Some(c) = &full.caustics {
         eprintln!(
-            "caustic passes: G-buffer {:.2} ms, rays {:.2} ms, cells {:.2} ms; {} of {} rays landed on a receiver",
+            "caustic passes: G-buffer {:.2} ms, rays {:.2} ms, cells {:.2} ms, beams {:.2} ms; {} of {} rays landed on a receiver",
             ms(c.gbuffer_seconds),
             ms(c.trace_seconds),
             ms(c.splat_seconds),
+            ms(c.beam_seconds),
             c.landed,
             c.rays
         );
     }
+}
+
+fn compare(args: CompareArgs) -> Result<()> {
+    let read = |path: &Path| -> Result<quadray::passes::RenderOutput> {
+        let (width, height, texels) =
+            quadray::texture::read_exr_image(path).with_context(|| format!("cannot read {}", path.display()))?;
+        Ok(quadray::passes::RenderOutput {
+            width,
+            height,
+            radiance: texels.iter().map(|t| [t[0], t[1], t[2]]).collect(),
+            aov: vec![],
+            spp: 0,
+            seconds: 0.0,
+            caustics: None,
+            volume_seconds: None,
+        })
+    };
+    let reference = read(&args.reference)?;
+    let test = read(&args.test)?;
+    if (reference.width, reference.height) != (test.width, test.height) {
+        bail!(
+            "{} is {}x{} but {} is {}x{}",
+            args.reference.display(),
+            reference.width,
+            reference.height,
+            args.test.display(),
+            test.width,
+            test.height
+        );
+    }
+    let flip = quadray::metrics::flip_mean(&reference, &test, args.exposure)?;
+    let rel_mse = quadray::metrics::relative_mse(&reference, &test)?;
+    let lum = |p: &[f32; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let (worst, _) =
+        reference.radiance.iter().zip(&test.radiance).enumerate().fold((0, -1.0f32), |best, (i, (r, t))| {
+            let d = (lum(r) - lum(t)).abs();
+            if d > best.1 {
+                (i, d)
+            } else {
+                best
+            }
+        });
+    println!("FLIP {flip:.4}  relative MSE {rel_mse:.5}");
+    println!(
+        "largest luminance difference at pixel ({}, {}): reference {:.4}, test {:.4}",
+        worst as u32 % reference.width,
+        worst as u32 / reference.width,
+        lum(&reference.radiance[worst]),
+        lum(&test.radiance[worst])
+    );
+    Ok(())
 }
 
 fn filter_bench(args: FilterBenchArgs) -> Result<()> {
@@ -488,6 +555,7 @@ fn main() -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => render(args),
         Some(Command::FilterBench(args)) => filter_bench(args),
+        Some(Command::Compare(args)) => compare(args),
         None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),
     }
 }

@@ -35,6 +35,83 @@ const MAX_NORMAL_DEGREES: f64 = 0.1;
 /// Hits within this angle of grazing (or near the silhouette) are excused.
 const SILHOUETTE_DEGREES: f64 = 1.0;
 
+/// Agreement of the GPU's hits with the f64 reference on one placement.
+#[derive(Default)]
+struct Agreement {
+    hits: usize,
+    agree: usize,
+    excused: usize,
+    failures: usize,
+    max_depth: f64,
+    max_normal: f64,
+}
+
+/// Traces `RAYS` rays from 6 `s` away from `centre` toward random points of
+/// the box `target_radius` · s around it, on the GPU (frame origin `origin`)
+/// and in f64 on the same f32 rays.
+#[allow(clippy::too_many_arguments)]
+fn measure(
+    ctx: &quadray::vk::Context,
+    cmds: &mut Commands,
+    rng: &mut Pcg64,
+    shape: &FunctionalObject,
+    transform: DAffine3,
+    origin: DVec3,
+    s: f64,
+    target_radius: f64,
+) -> Agreement {
+    let bounds = shape.bounds().unwrap();
+    let centre = transform.translation;
+    let inverse = transform.inverse();
+    let object = quadray::scene::SceneObject { transform, ..common::object("shape", shape.clone(), transform) };
+    let scene = common::scene_with(vec![object]);
+    let gpu = GpuScene::with_origin(&ctx.device, cmds, &scene, &CellParams::default(), origin).unwrap();
+    let rays: Vec<GpuRay> = (0..RAYS)
+        .map(|_| {
+            let o = centre + 6.0 * s * common::random_unit(rng);
+            let jitter = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 - 1.0;
+            let target = centre + target_radius * s * jitter;
+            let d = (target - o).normalize();
+            let o = o - origin;
+            GpuRay { origin: o.as_vec3().to_array(), tmin: 0.0, dir: d.as_vec3().to_array(), tmax: 1e30 }
+        })
+        .collect();
+    let (hits, _) = ProbePass::new(&ctx.device, &gpu, &rays, INTERSECT_FULL, false).unwrap().run(cmds).unwrap();
+    drop(gpu);
+    let mut a = Agreement::default();
+    let sil = SILHOUETTE_DEGREES.to_radians().sin();
+    for (ray, g) in rays.iter().zip(&hits) {
+        assert!(g.t.is_finite() || g.object == NO_HIT, "non-finite t");
+        assert!(g.normal.iter().all(|v| v.is_finite()), "non-finite normal");
+        let o = origin + DVec3::from_array(ray.origin.map(f64::from));
+        let d = DVec3::from_array(ray.dir.map(f64::from));
+        let (ol, dl) = (inverse.transform_point3(o), inverse.transform_vector3(d));
+        let r = reference::intersect_within(shape, &bounds, ol, dl, 0.0, f64::INFINITY);
+        let r = r.map(|h| {
+            let n = (inverse.matrix3.transpose() * h.normal).normalize();
+            (h.t, n)
+        });
+        let gn = DVec3::from_array(g.normal.map(f64::from));
+        let near_edge = r.is_some_and(|(_, n)| n.dot(d).abs() < sil) || (g.object != NO_HIT && gn.dot(d).abs() < sil);
+        match (r, g.object != NO_HIT) {
+            (None, false) => a.agree += 1,
+            (Some((t, n)), true) if ((g.t as f64) - t).abs() < 0.05 * t => {
+                a.hits += 1;
+                if near_edge {
+                    a.excused += 1;
+                    continue;
+                }
+                a.agree += 1;
+                a.max_depth = a.max_depth.max(((g.t as f64) - t).abs() / t);
+                a.max_normal = a.max_normal.max(gn.dot(n).clamp(-1.0, 1.0).acos().to_degrees());
+            }
+            _ if near_edge => a.excused += 1,
+            _ => a.failures += 1,
+        }
+    }
+    a
+}
+
 #[test]
 fn scales_and_offsets_against_the_f64_reference() {
     let shape = FunctionalObject {
@@ -42,7 +119,6 @@ fn scales_and_offsets_against_the_f64_reference() {
         perturbations: common::spread_bumps(40, 1.0, 0.3, 0.5, true),
         clip: None,
     };
-    let bounds = shape.bounds().unwrap();
     let ctx = common::context();
     let counters = ctx.counters();
     let mut cmds = Commands::new(&ctx.device).unwrap();
@@ -71,67 +147,23 @@ fn scales_and_offsets_against_the_f64_reference() {
                     glam::DQuat::from_rotation_y(0.7),
                     centre,
                 );
-                let inverse = transform.inverse();
-                let object =
-                    quadray::scene::SceneObject { transform, ..common::object("ball", shape.clone(), transform) };
-                let scene = common::scene_with(vec![object]);
                 let origin = if relative { centre + DVec3::new(0.0, 0.0, 6.0 * s) } else { DVec3::ZERO };
-                let gpu =
-                    GpuScene::with_origin(&ctx.device, &mut cmds, &scene, &CellParams::default(), origin).unwrap();
-                let rays: Vec<GpuRay> = (0..RAYS)
-                    .map(|_| {
-                        let o = centre + 6.0 * s * common::random_unit(&mut rng);
-                        let target = centre + 1.3 * s * DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.65 * s;
-                        let d = (target - o).normalize();
-                        let o = o - origin;
-                        GpuRay { origin: o.as_vec3().to_array(), tmin: 0.0, dir: d.as_vec3().to_array(), tmax: 1e30 }
-                    })
-                    .collect();
-                let (hits, _) =
-                    ProbePass::new(&ctx.device, &gpu, &rays, INTERSECT_FULL, false).unwrap().run(&mut cmds).unwrap();
-                drop(gpu);
-
+                let a = measure(&ctx, &mut cmds, &mut rng, &shape, transform, origin, s, 0.65);
                 let epsilon = 6e-8 * ((centre - origin).length() + 6.0 * s) / s;
-                let (mut n_hits, mut agree, mut excused, mut failures) = (0, 0, 0, 0);
-                let (mut max_depth, mut max_normal) = (0.0f64, 0.0f64);
-                let sil = SILHOUETTE_DEGREES.to_radians().sin();
-                for (ray, g) in rays.iter().zip(&hits) {
-                    assert!(g.t.is_finite() || g.object == NO_HIT, "non-finite t");
-                    assert!(g.normal.iter().all(|v| v.is_finite()), "non-finite normal");
-                    let o = origin + DVec3::from_array(ray.origin.map(f64::from));
-                    let d = DVec3::from_array(ray.dir.map(f64::from));
-                    let (ol, dl) = (inverse.transform_point3(o), inverse.transform_vector3(d));
-                    let r = reference::intersect_within(&shape, &bounds, ol, dl, 0.0, f64::INFINITY);
-                    let r = r.map(|h| {
-                        let n = (inverse.matrix3.transpose() * h.normal).normalize();
-                        (h.t, n)
-                    });
-                    let gn = DVec3::from_array(g.normal.map(f64::from));
-                    let near_edge =
-                        r.is_some_and(|(_, n)| n.dot(d).abs() < sil) || (g.object != NO_HIT && gn.dot(d).abs() < sil);
-                    match (r, g.object != NO_HIT) {
-                        (None, false) => agree += 1,
-                        (Some((t, n)), true) if ((g.t as f64) - t).abs() < 0.05 * t => {
-                            n_hits += 1;
-                            if near_edge {
-                                excused += 1;
-                                continue;
-                            }
-                            agree += 1;
-                            max_depth = max_depth.max(((g.t as f64) - t).abs() / t);
-                            max_normal = max_normal.max(gn.dot(n).clamp(-1.0, 1.0).acos().to_degrees());
-                        }
-                        _ if near_edge => excused += 1,
-                        _ => failures += 1,
-                    }
-                }
                 let bounded = epsilon <= TRUSTED_EPSILON;
                 let frame = if relative { "relative" } else { "world" };
                 println!(
-                "{frame:>9} {s:>8.0e} {offset:>8.0e} {epsilon:>9.1e} {n_hits:>6} {agree:>6} {excused:>8} {failures:>8} {max_depth:>11.2e} {max_normal:>11.4} {:>8}",
-                if bounded { "yes" } else { "no" }
-            );
-                if bounded && (failures > 0 || max_depth > MAX_DEPTH_ERROR + epsilon || max_normal > MAX_NORMAL_DEGREES)
+                    "{frame:>9} {s:>8.0e} {offset:>8.0e} {epsilon:>9.1e} {:>6} {:>6} {:>8} {:>8} {:>11.2e} {:>11.4} {:>8}",
+                    a.hits,
+                    a.agree,
+                    a.excused,
+                    a.failures,
+                    a.max_depth,
+                    a.max_normal,
+                    if bounded { "yes" } else { "no" }
+                );
+                if bounded
+                    && (a.failures > 0 || a.max_depth > MAX_DEPTH_ERROR + epsilon || a.max_normal > MAX_NORMAL_DEGREES)
                 {
                     violations.push(format!("{frame} frame, scale {s:e}, offset {offset:e}"));
                 }
@@ -141,6 +173,136 @@ fn scales_and_offsets_against_the_f64_reference() {
     println!(
         "bounds where ε <= {TRUSTED_EPSILON:e}: no unexcused disagreement, depth error <= {MAX_DEPTH_ERROR:e} + ε, normal {MAX_NORMAL_DEGREES}°"
     );
+    drop(cmds);
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+    assert!(violations.is_empty(), "beyond the bounds: {violations:?}");
+}
+
+/// One extreme shape of [`shapes_at_the_extremes_against_the_f64_reference`]:
+/// its name, the shape, how far from its centre the rays aim, whether the
+/// bounds are expected to hold (`false`: a known degradation, printed and
+/// checked only for NaN/Inf; docs/stability.md), and its bounds on
+/// unexcused disagreements (as a fraction of the rays), relative depth
+/// error and normal error (degrees).
+struct Extreme {
+    name: String,
+    shape: FunctionalObject,
+    aim: f64,
+    holds: bool,
+    max_failures: f64,
+    max_depth: f64,
+    max_normal: f64,
+}
+
+fn extremes() -> Vec<Extreme> {
+    let sphere = |perturbations| FunctionalObject {
+        base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE),
+        perturbations,
+        clip: None,
+    };
+    let mut out = Vec::new();
+    // Form factors of 12 alternating bumps and dents (radius 0.4) relative to
+    // the unit sphere's, from invisible to walls at the supports' edges.
+    for f in [1e-6, 1e-3, 1.0, 1e3, 1e6] {
+        out.push(Extreme {
+            name: format!("form factor {f:.0e}"),
+            shape: sphere(common::spread_bumps(12, 1.0, 0.4, f, true)),
+            aim: 1.2,
+            // Beyond f ~ 1e2 the surface hugs the bumps' support boundary,
+            // where f Q³ has a near-triple root: the f32 search degrades.
+            holds: f <= 1.0,
+            max_failures: 0.0,
+            max_depth: 1e-4,
+            max_normal: 0.5,
+        });
+    }
+    out.push(Extreme {
+        name: "300 overlapping bumps".into(),
+        shape: sphere(common::spread_bumps(300, 1.0, 0.5, 0.05, true)),
+        aim: 1.0,
+        holds: true,
+        max_failures: 0.0,
+        max_depth: 1e-4,
+        max_normal: 0.5,
+    });
+    for (name, radii) in
+        [("thin ellipsoid 1e-3", DVec3::new(1.0, 1e-3, 1.0)), ("needle 1e-3", DVec3::new(1e-3, 1.0, 1e-3))]
+    {
+        out.push(Extreme {
+            name: name.into(),
+            shape: FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, radii), perturbations: vec![], clip: None },
+            aim: 0.8,
+            holds: true,
+            max_failures: 0.0,
+            max_depth: 1e-4,
+            max_normal: 0.5,
+        });
+    }
+    // A double cone (inside F = y² − x² − z² ≥ 0) clipped to |p| ≤ 1: rays
+    // aimed at its apex.
+    out.push(Extreme {
+        name: "cone apex".into(),
+        shape: FunctionalObject {
+            base: Quadric::from_coefficients([-1.0, 1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            perturbations: vec![],
+            clip: Some(quadray::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
+        },
+        aim: 0.05,
+        holds: true,
+        max_failures: 0.0,
+        max_depth: 1e-4,
+        max_normal: 0.5,
+    });
+    out
+}
+
+/// Shapes at the extremes against the f64 reference: perturbation form
+/// factors from 1e-6 to 1e6 of the base's, hundreds of overlapping
+/// perturbations, nearly degenerate quadrics (thin and needle ellipsoids, a
+/// cone's apex). Each case states its bounds; the table prints the measured
+/// figures.
+#[test]
+fn shapes_at_the_extremes_against_the_f64_reference() {
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let mut rng = Pcg64::seed_from_u64(7);
+    println!(
+        "{:>22} {:>6} {:>6} {:>8} {:>8} {:>11} {:>11}",
+        "shape", "hits", "agree", "excused", "failures", "max depth", "max normal°"
+    );
+    let mut violations = Vec::new();
+    for e in extremes() {
+        let transform = DAffine3::from_rotation_y(0.7);
+        let a = measure(&ctx, &mut cmds, &mut rng, &e.shape, transform, DVec3::new(0.0, 0.0, 6.0), 1.0, e.aim);
+        println!(
+            "{:>22} {:>6} {:>6} {:>8} {:>8} {:>11.2e} {:>11.4}   {}",
+            e.name,
+            a.hits,
+            a.agree,
+            a.excused,
+            a.failures,
+            a.max_depth,
+            a.max_normal,
+            if e.holds {
+                format!(
+                    "bounds: failures {:.0}%, depth {:.0e}, normal {}°",
+                    100.0 * e.max_failures,
+                    e.max_depth,
+                    e.max_normal
+                )
+            } else {
+                "degrades (known; finite values only)".to_string()
+            }
+        );
+        let within = a.failures as f64 <= e.max_failures * RAYS as f64
+            && a.max_depth <= e.max_depth
+            && a.max_normal <= e.max_normal;
+        if e.holds && !within {
+            violations.push(e.name);
+        }
+    }
     drop(cmds);
     drop(ctx);
     common::assert_no_validation_errors(&counters);

@@ -236,6 +236,13 @@ pub fn load_texture_file(path: &Path, usage: TextureUsage) -> Result<LoadedTextu
     Ok(LoadedTexture { image, channels, has_alpha })
 }
 
+/// Reads an EXR image as it is (no resampling, no mips): width, height and
+/// linear RGBA texels, row 0 at the top. Used to compare renders.
+pub fn read_exr_image(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>), TextureError> {
+    let (width, height, texels, _, _) = read_exr(path)?;
+    Ok((width, height, texels))
+}
+
 /// A texture from level-0 texels in linear RGBA (row-major, row 0 at the
 /// top): resamples non-power-of-two sizes up ([`resample_to_power_of_two`])
 /// and builds the mip chain ([`build_mips`]).
