@@ -13,24 +13,13 @@
 mod common;
 
 use quadray::passes::RenderVariant;
+use quadray::sampling::fresnel::fresnel_dielectric;
 use quadray::scene::parse_scene;
 
 /// Relative error allowed on the deposited flux: the grid's boundary rays
 /// deposit part of their flux (about 1 / (rays across the ball)), and the
 /// pixels integrate the map by the midpoint rule.
 const FLUX_TOLERANCE: f64 = 0.02;
-
-/// Unpolarised Fresnel reflectance at a smooth interface (f64), `eta` = n_t / n_i.
-fn fresnel(cos_i: f64, eta: f64) -> f64 {
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (r_par * r_par + r_perp * r_perp)
-}
 
 /// Flux through a ball of radius `r` at distance `d` from a point light of
 /// intensity `intensity` after two refractions: ∫ I (1 − F)² dω over the
@@ -43,7 +32,7 @@ fn predicted_flux(intensity: f64, d: f64, r: f64, eta: f64) -> f64 {
         .map(|k| {
             let psi = (k as f64 + 0.5) * h;
             let sin_i = (d * psi.sin() / r).min(1.0);
-            let t = 1.0 - fresnel((1.0 - sin_i * sin_i).sqrt(), eta);
+            let t = 1.0 - fresnel_dielectric((1.0 - sin_i * sin_i).sqrt(), eta);
             intensity * t * t * 2.0 * std::f64::consts::PI * psi.sin() * h
         })
         .sum()

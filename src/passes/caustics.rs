@@ -23,7 +23,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::gpu::{GpuCausticRay, GpuEmitter, GpuReceiver};
 use super::scene_gpu::GpuScene;
@@ -149,11 +149,40 @@ fn specular_corners(scene: &Scene) -> Vec<DVec3> {
 
 /// Grid dimensions with about `rays` rays over a rectangle of `size`, with
 /// square grid cells.
-fn grid_for(size: glam::DVec2, rays: u32) -> [u32; 2] {
+fn grid_for(size: DVec2, rays: u32) -> [u32; 2] {
     let aspect = (size.x / size.y.max(1e-30)).clamp(1e-3, 1e3);
     let nx = ((rays as f64 * aspect).sqrt().round() as u32).max(2);
     let ny = (rays / nx).max(2);
     [nx, ny]
+}
+
+/// The rectangle in the plane spanned by `u`, `v` that bounds `corners`
+/// mapped to it by `to_plane` (`None` from `to_plane` fails the whole).
+fn plane_bounds(corners: &[DVec3], to_plane: impl Fn(DVec3) -> Option<DVec2>) -> Option<(DVec2, DVec2)> {
+    let (mut lo, mut hi) = (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN));
+    for &c in corners {
+        let xy = to_plane(c)?;
+        lo = lo.min(xy);
+        hi = hi.max(xy);
+    }
+    Some((lo, hi))
+}
+
+/// An emission grid of `kind` over [lo, hi] of the plane (u, v) with axis w.
+fn grid_emitter(kind: u32, origin: DVec3, w: DVec3, (lo, hi): (DVec2, DVec2), rays: u32, power: DVec3) -> GpuEmitter {
+    let (u, v) = w.any_orthonormal_pair();
+    GpuEmitter {
+        origin: origin.as_vec3().to_array(),
+        kind,
+        u: u.as_vec3().to_array(),
+        v: v.as_vec3().to_array(),
+        w: w.as_vec3().to_array(),
+        lo: lo.as_vec2().to_array(),
+        hi: hi.as_vec2().to_array(),
+        grid: grid_for(hi - lo, rays),
+        power: power.as_vec3().to_array(),
+        ..Default::default()
+    }
 }
 
 /// Rays from `p` over the tangent-plane rectangle (at distance 1 along the
@@ -162,29 +191,12 @@ fn grid_for(size: glam::DVec2, rays: u32) -> [u32; 2] {
 fn point_grid(p: DVec3, intensity: DVec3, corners: &[DVec3], centre: DVec3, rays: u32) -> Option<GpuEmitter> {
     let w = (centre - p).normalize_or(DVec3::Z);
     let (u, v) = w.any_orthonormal_pair();
-    let (mut lo, mut hi) = (glam::DVec2::splat(f64::MAX), glam::DVec2::splat(f64::MIN));
-    for &c in corners {
+    let bounds = plane_bounds(corners, |c| {
         let r = c - p;
         let z = r.dot(w);
-        if z <= 1e-6 * r.length() {
-            return None;
-        }
-        let xy = glam::DVec2::new(r.dot(u), r.dot(v)) / z;
-        lo = lo.min(xy);
-        hi = hi.max(xy);
-    }
-    Some(GpuEmitter {
-        origin: p.as_vec3().to_array(),
-        kind: EMITTER_POINT,
-        u: u.as_vec3().to_array(),
-        v: v.as_vec3().to_array(),
-        w: w.as_vec3().to_array(),
-        lo: lo.as_vec2().to_array(),
-        hi: hi.as_vec2().to_array(),
-        grid: grid_for(hi - lo, rays),
-        power: intensity.as_vec3().to_array(),
-        ..Default::default()
-    })
+        (z > 1e-6 * r.length()).then(|| DVec2::new(r.dot(u), r.dot(v)) / z)
+    })?;
+    Some(grid_emitter(EMITTER_POINT, p, w, bounds, rays, intensity))
 }
 
 /// Parallel rays along `w` over the rectangle that bounds `corners` in the
@@ -192,27 +204,12 @@ fn point_grid(p: DVec3, intensity: DVec3, corners: &[DVec3], centre: DVec3, rays
 fn parallel_grid(w: DVec3, irradiance: DVec3, corners: &[DVec3], centre: DVec3, radius: f64, rays: u32) -> GpuEmitter {
     let w = w.normalize();
     let (u, v) = w.any_orthonormal_pair();
-    let (mut lo, mut hi) = (glam::DVec2::splat(f64::MAX), glam::DVec2::splat(f64::MIN));
-    for &c in corners {
-        let xy = glam::DVec2::new((c - centre).dot(u), (c - centre).dot(v));
-        lo = lo.min(xy);
-        hi = hi.max(xy);
-    }
-    GpuEmitter {
-        origin: (centre - w * (2.0 * radius + 1.0)).as_vec3().to_array(),
-        kind: EMITTER_PARALLEL,
-        u: u.as_vec3().to_array(),
-        v: v.as_vec3().to_array(),
-        w: w.as_vec3().to_array(),
-        lo: lo.as_vec2().to_array(),
-        hi: hi.as_vec2().to_array(),
-        grid: grid_for(hi - lo, rays),
-        power: irradiance.as_vec3().to_array(),
-        ..Default::default()
-    }
+    let bounds = plane_bounds(corners, |c| Some(DVec2::new((c - centre).dot(u), (c - centre).dot(v))))
+        .expect("parallel projection always succeeds");
+    grid_emitter(EMITTER_PARALLEL, centre - w * (2.0 * radius + 1.0), w, bounds, rays, irradiance)
 }
 
-/// The descriptor layout shared by the three caustic shaders.
+/// The descriptor layout shared by the caustic shaders.
 fn binding_kinds() -> Vec<BindingKind> {
     let mut kinds = vec![BindingKind::AccelerationStructure];
     kinds.extend([BindingKind::StorageBuffer; 11]);
@@ -269,21 +266,13 @@ impl CausticMap {
         let trace = ComputePipeline::new(device, &shaders::caustic_trace(), &kinds, push, &specialisation)?;
         let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &kinds, push, &specialisation)?;
         let beam = ComputePipeline::new(device, &shaders::caustic_beams(), &kinds, push, &specialisation)?;
-        let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
-        let bindings = [
-            tlas,
-            objects,
-            cells,
-            perturbations,
-            lists,
-            Binding::Buffer(&gpu.materials),
-            Binding::Buffer(&gpu.lights),
-            Binding::Buffer(frame),
+        let mut bindings = gpu.frame_bindings(frame);
+        bindings.extend([
             Binding::Buffer(&rays),
             Binding::Buffer(&receivers),
             Binding::Buffer(&map),
             Binding::Buffer(&beams),
-        ];
+        ]);
         for p in [&gbuffer, &trace, &splat, &beam] {
             p.bind(&bindings);
         }

@@ -176,16 +176,8 @@ pub fn render(
             u32::from(caustics.as_ref().is_some_and(|c| c.has_beams)),
         ],
     )?;
-    let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
-    pipeline.bind(&[
-        tlas,
-        objects,
-        cells,
-        perturbations,
-        lists,
-        Binding::Buffer(&gpu.materials),
-        Binding::Buffer(&gpu.lights),
-        Binding::Buffer(&frame_buf),
+    let mut bindings = gpu.frame_bindings(&frame_buf);
+    bindings.extend([
         Binding::Image(&accum),
         Binding::Buffer(&aov),
         gpu.texture_binding(),
@@ -195,6 +187,7 @@ pub fn render(
         Binding::Buffer(volume_radiance),
         Binding::Buffer(beam_map),
     ]);
+    pipeline.bind(&bindings);
 
     let tiles: Vec<[u32; 4]> = (0..height)
         .step_by(TILE as usize)

@@ -240,6 +240,15 @@ impl GpuScene {
         Binding::Textures(images, &self.sampler)
     }
 
+    /// The bindings `BINDING_TLAS..=BINDING_FRAME` of the passes that trace
+    /// the scene for an image: geometry, materials, lights, and `frame`
+    /// (`GpuFrame`).
+    pub fn frame_bindings<'a>(&'a self, frame: &'a Buffer) -> Vec<Binding<'a>> {
+        let mut bindings = self.geometry_bindings().into_iter().collect::<Vec<_>>();
+        bindings.extend([Binding::Buffer(&self.materials), Binding::Buffer(&self.lights), Binding::Buffer(frame)]);
+        bindings
+    }
+
     /// The bindings `BINDING_TLAS..=BINDING_CELL_LISTS` shared by all passes.
     pub fn geometry_bindings(&self) -> [Binding<'_>; 5] {
         [

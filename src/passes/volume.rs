@@ -46,18 +46,9 @@ impl VolumeLight {
         let mut kinds = vec![BindingKind::AccelerationStructure];
         kinds.extend([BindingKind::StorageBuffer; 8]);
         let pipeline = ComputePipeline::new(device, &shaders::volume(), &kinds, 12, &[INTERSECT_FULL])?;
-        let [tlas, objects, cells, perturbations, lists] = gpu.geometry_bindings();
-        pipeline.bind(&[
-            tlas,
-            objects,
-            cells,
-            perturbations,
-            lists,
-            Binding::Buffer(&gpu.materials),
-            Binding::Buffer(&gpu.lights),
-            Binding::Buffer(frame),
-            Binding::Buffer(&radiance),
-        ]);
+        let mut bindings = gpu.frame_bindings(frame);
+        bindings.push(Binding::Buffer(&radiance));
+        pipeline.bind(&bindings);
         let start = Instant::now();
         cmds.run(|d, cmd| unsafe { d.cmd_fill_buffer(cmd, radiance.raw, 0, vk::WHOLE_SIZE, 0) })?;
         for first in (0..samples).step_by(BATCH as usize) {
