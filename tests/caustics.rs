@@ -103,3 +103,20 @@ fn scenes_without_specular_objects_run_no_caustic_pass() {
     assert!(out.caustics.is_none(), "caustic passes ran");
     println!("one_sphere: no caustic pass ran (0 s in caustic passes)");
 }
+
+/// FLIP between the lens in fog with the caustic passes (beams included)
+/// and a long brute-force render.
+const LENS_FOG_FLIP_BOUND: f64 = 0.1;
+
+#[test]
+fn lens_in_fog_beams_match_the_brute_force_path_tracer() {
+    let c = common::compare_with_brute_force("lens_fog", 2048, 64);
+    let report = c.fast.caustics.as_ref().expect("the caustic passes ran");
+    assert!(report.beam_seconds > 0.0, "the beam pass ran");
+    println!(
+        "lens in fog: FLIP against brute force at 2048 spp: passes at 64 spp {:.4} (bound {LENS_FOG_FLIP_BOUND}), \
+         brute force at 64 spp {:.4}",
+        c.flip_fast, c.flip_brute
+    );
+    assert!(c.flip_fast < LENS_FOG_FLIP_BOUND);
+}
