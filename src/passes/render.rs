@@ -31,7 +31,7 @@ pub struct RenderOutput {
     pub aov: Vec<GpuAov>,
     /// Samples per pixel taken.
     pub spp: u32,
-    /// Wall time of the GPU work in seconds (the caustic passes included).
+    /// Wall time of the GPU work in seconds (the caustic and volume passes included).
     pub seconds: f64,
     /// What the caustic passes did, when they ran.
     pub caustics: Option<CausticReport>,
@@ -100,16 +100,12 @@ pub fn render(
     };
     let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
     let caustics = caustic_map(device, cmds, gpu, scene, &frame_buf, (width, height), variant)?;
-    // Placeholders for the render shader's caustic bindings when the passes did not run.
+    // Bound in place of the outputs of the passes that did not run.
     let placeholder =
-        |name| Buffer::new(device, name, 24, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuOnly);
-    let (receivers_placeholder, map_placeholder) = match caustics {
-        Some(_) => (None, None),
-        None => (Some(placeholder("no receivers")?), Some(placeholder("no caustic map")?)),
-    };
-    let receivers = caustics.as_ref().map_or_else(|| receivers_placeholder.as_ref().unwrap(), |c| &c.receivers);
-    let caustic_map = caustics.as_ref().map_or_else(|| map_placeholder.as_ref().unwrap(), |c| &c.map);
-    let beam_map = caustics.as_ref().map_or_else(|| map_placeholder.as_ref().unwrap(), |c| &c.beams);
+        Buffer::new(device, "placeholder", 24, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuOnly)?;
+    let receivers = caustics.as_ref().map_or(&placeholder, |c| &c.receivers);
+    let caustic_map = caustics.as_ref().map_or(&placeholder, |c| &c.map);
+    let beam_map = caustics.as_ref().map_or(&placeholder, |c| &c.beams);
     let volume = if variant.volume && variant.shading == SHADING_FULL && scene.needs_volume() {
         Some(VolumeLight::compute(
             device,
@@ -122,11 +118,7 @@ pub fn render(
     } else {
         None
     };
-    let volume_placeholder = match volume {
-        Some(_) => None,
-        None => Some(placeholder("no volume radiance")?),
-    };
-    let volume_radiance = volume.as_ref().map_or_else(|| volume_placeholder.as_ref().unwrap(), |v| &v.radiance);
+    let volume_radiance = volume.as_ref().map_or(&placeholder, |v| &v.radiance);
     let accum = Image::new(
         device,
         "accumulation",
