@@ -31,7 +31,16 @@ fn sphere_scene(n: usize) -> Scene {
         clip: None,
     };
     Scene {
-        image: ImageSettings { width: 1, height: 1, spp: 1, seed: 0, exposure: 0.0, max_depth: 1 },
+        image: ImageSettings {
+            width: 1,
+            height: 1,
+            spp: 1,
+            seed: 0,
+            exposure: 0.0,
+            max_depth: 1,
+            filter: Default::default(),
+            preset: None,
+        },
         camera: Camera { position: DVec3::new(0.0, 0.0, 4.0), look_at: DVec3::ZERO, up: DVec3::Y, vfov_degrees: 40.0 },
         background: Vec3::ZERO,
         materials: vec![Material::diffuse("grey", Vec3::splat(0.8))],

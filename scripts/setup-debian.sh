@@ -6,7 +6,9 @@
 #     on Debian 12 it comes from bookworm-backports),
 #   - Debian's shaderc / glslang / SPIRV-Tools libraries, linked statically
 #     (see .cargo/config.toml) so that shaderc is not compiled from source,
-#   - a C/C++ toolchain for linking (gcc, g++, libc6-dev) and make.
+#   - a C/C++ toolchain for linking (gcc, g++, libc6-dev) and make,
+#   - Xvfb and the X11 client libraries winit loads at run time, for the
+#     viewer (`quadray view`) and its test under a virtual display.
 # Idempotent: it installs only what is missing and does nothing when all is there.
 # Prints one line per step; apt's output goes to a log file that is shown
 # (its tail) only when a step fails. QUADRAY_SETUP_LOG overrides its path.
@@ -16,7 +18,8 @@ SUDO=""
 if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
 
 need_pkgs=(libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools
-           pkg-config gcc g++ libc6-dev make ca-certificates mesa-vulkan-drivers)
+           pkg-config gcc g++ libc6-dev make ca-certificates mesa-vulkan-drivers
+           xvfb libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
 
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 

@@ -507,16 +507,10 @@ fn cached_reference(
                     bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
                 let radiance = floats.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
                 eprintln!("{}: cached reference ({} spp)", base.display(), info.spp);
-                let out = RenderOutput {
-                    width: info.width,
-                    height: info.height,
-                    radiance,
-                    aov: vec![],
-                    spp: info.spp,
-                    seconds: stored.seconds,
-                    caustics: None,
-                    volume_seconds: None,
-                };
+                let mut out = RenderOutput::from_radiance(info.width, info.height, radiance);
+                out.spp = info.spp;
+                out.seconds = stored.seconds;
+                out.render_seconds = stored.seconds;
                 return Ok((out, stored));
             }
         }

@@ -8,6 +8,7 @@
 //! - [`passes`]: GPU passes.
 //! - [`output`]: PNG and EXR files, written atomically.
 
+pub mod bench;
 pub mod covariance;
 pub mod filter_bench;
 pub mod geometry;
@@ -16,11 +17,13 @@ pub mod metrics;
 pub mod output;
 pub mod passes;
 pub mod plot;
+pub mod progress;
 pub mod sampling;
 pub mod scene;
 pub mod shader_interface;
 pub mod shaders;
 pub mod texture;
+pub mod viewer;
 pub mod vk;
 
 /// Errors of rendering a scene.

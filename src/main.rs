@@ -1,13 +1,12 @@
 //! The `quadray` command line: render a scene file to PNG and EXR.
 
-use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
 use quadray::output::{write_outputs, ExrPrecision, OutputKind};
-use quadray::scene::{load_scene, parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+use quadray::progress::ProgressBar;
+use quadray::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
 /// A Vulkan path tracer for functionally defined objects (perturbed quadrics).
 ///
@@ -28,9 +27,87 @@ enum Command {
     /// Markdown and PNG plots), the time each mode takes to reach the error
     /// of `none` at the largest spp, and temporal stability over a camera pan.
     FilterBench(FilterBenchArgs),
+    /// Open a window that renders a scene progressively, with an orbit and
+    /// fly camera and keys for the filtering mode, preset, caustics, volume
+    /// and screenshots (README.md, "The viewer").
+    View(ViewArgs),
+    /// Measure the quality presets' speed/accuracy trade: each scene rendered
+    /// at each preset and compared with its `reference` render (FLIP and
+    /// relative MSE against GPU time per pass); writes bench.json, bench.md,
+    /// bench.png (error against time) and the renders.
+    Bench(BenchArgs),
     /// Compare a render with a reference: FLIP (mean, from nv-flip) and
     /// relative MSE between two EXR files of the same size.
     Compare(CompareArgs),
+}
+
+#[derive(Parser, Debug)]
+#[command(after_help = concat!("Keys:\n", "mouse: left drag orbits, right drag turns the view, wheel dollies\n",
+    "W A S D: fly forward, left, back, right    Q E: down, up    (arrow keys: orbit)\n",
+    "F: next filtering mode    P: next preset    1 2 3 4: preview, interactive, final, reference\n",
+    "C: caustics on/off    V: volume on/off    R: reset camera\n",
+    "F12 or O: screenshot (PNG + EXR)    Esc: close"))]
+struct ViewArgs {
+    /// Scene file (TOML). Omit it to view the built-in default scene.
+    scene: Option<PathBuf>,
+    /// Quality preset to start with (default: the scene's, else `interactive`).
+    #[command(flatten)]
+    quality: QualityArgs,
+    /// Initial window width (overrides `image.width`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Initial window height (overrides `image.height`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Samples per pixel to accumulate before the view stops refining
+    /// (default: the preset's or scene's spp).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    max_spp: Option<u32>,
+    /// Start with the caustic and volume passes off (brute force).
+    #[arg(long)]
+    brute_force: bool,
+    /// Folder for screenshots.
+    #[arg(long, default_value = ".")]
+    screenshot_dir: PathBuf,
+    /// Steps to run, separated by `;` (for automation and tests): `wait N`
+    /// (N spp on screen), `frames N`, `screenshot [NAME]`, `key K`,
+    /// `orbit YAW PITCH`, `resize WxH`, `minimize`, `restore`, `close`.
+    #[arg(long)]
+    script: Option<String>,
+    /// Enable the Khronos validation layer; the command fails if it reports errors.
+    #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
+    validation: bool,
+}
+
+#[derive(Parser, Debug)]
+struct BenchArgs {
+    /// Scene files; `default` is the built-in default scene. Default: the
+    /// default scene and the figure scenes (figure 1 left and right, the
+    /// glass vessel of figure 2).
+    #[arg(default_values = ["default", "scenes/figure1_left.toml", "scenes/figure1_right.toml", "scenes/glass_vessel.toml"])]
+    scenes: Vec<String>,
+    /// The presets to measure against `reference`, comma separated.
+    #[arg(long, value_delimiter = ',', default_values = ["preview", "interactive", "final"])]
+    presets: Vec<Preset>,
+    /// Image width of every render (the scenes' own sizes make the
+    /// references slow on a CPU driver).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(8..=16384))]
+    width: u32,
+    /// Image height of every render.
+    #[arg(long, default_value_t = 192, value_parser = clap::value_parser!(u32).range(8..=16384))]
+    height: u32,
+    /// Samples per pixel of the reference (default: the `reference` preset's 1024).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    reference_spp: Option<u32>,
+    /// Output folder (created if missing); references are cached in its `cache/`.
+    #[arg(short, long, default_value = "results/bench")]
+    out: PathBuf,
+    /// Print progress even when stderr is not a terminal.
+    #[arg(long)]
+    progress: bool,
+    /// Enable the Khronos validation layer (fails on any error).
+    #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
+    validation: bool,
 }
 
 #[derive(Parser, Debug)]
@@ -105,9 +182,6 @@ struct RenderArgs {
     /// name without one of those extensions writes both `NAME.png` and `NAME.exr`.
     #[arg(short, long, default_value = "render")]
     output: PathBuf,
-    /// Samples per pixel (overrides the scene's `image.spp`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
-    spp: Option<u32>,
     /// Image width in pixels (overrides `image.width`).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     width: Option<u32>,
@@ -127,12 +201,6 @@ struct RenderArgs {
     /// Print progress even when stderr is not a terminal.
     #[arg(long)]
     progress: bool,
-    /// Texture filtering: `none` (bilinear lookups of the finest mip level; with
-    /// many samples per pixel, the reference), `ray-cones` (EWA lookups over
-    /// ray-cone footprints, Akenine-Möller et al. 2021) or `covariance` (EWA
-    /// lookups over covariance footprints carried along the path).
-    #[arg(long, value_enum, default_value_t = Filter::None)]
-    filter: Filter,
     /// Benchmark mode: after an untimed warm-up (lavapipe compiles shaders at
     /// their first dispatch), time the render and variants of it with parts of
     /// the work switched off (perturbation root finding, shading and
@@ -140,45 +208,13 @@ struct RenderArgs {
     /// write the full render's outputs.
     #[arg(long)]
     bench: bool,
-    /// Caustic rays per light and light sample (overrides `caustics.rays`; 0
-    /// switches the caustic passes off).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16_777_216))]
-    caustic_rays: Option<u32>,
-    /// Points on each sphere light that emit caustic rays (overrides
-    /// `caustics.light_samples`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    caustic_light_samples: Option<u32>,
-    /// Camera rays per pixel and render sample of the volume pass (overrides
-    /// `volume.samples`; 0 switches the volume pass off).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=65536))]
-    volume_samples: Option<u32>,
+    #[command(flatten)]
+    quality: QualityArgs,
     /// Brute force: no caustic or volume passes; the path tracer alone
     /// estimates caustics and the light scattered by the fog (the reference
     /// those passes are compared with).
     #[arg(long)]
     brute_force: bool,
-}
-
-/// Texture filtering modes of `--filter`.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
-enum Filter {
-    /// Bilinear lookups of mip level 0.
-    #[default]
-    None,
-    /// Ray cones with EWA lookups.
-    RayCones,
-    /// Covariance footprints with EWA lookups.
-    Covariance,
-}
-
-impl Filter {
-    fn constant(self) -> u32 {
-        match self {
-            Self::None => quadray::shader_interface::FILTER_NONE,
-            Self::RayCones => quadray::shader_interface::FILTER_RAY_CONES,
-            Self::Covariance => quadray::shader_interface::FILTER_COVARIANCE,
-        }
-    }
 }
 
 /// Which files `-o` asks for.
@@ -195,68 +231,76 @@ fn output_paths(output: &Path) -> Vec<PathBuf> {
     }
 }
 
-/// A progress line on stderr, shown once a render has run for a second.
-struct ProgressLine {
-    start: Instant,
-    enabled: bool,
-    shown: bool,
+/// The quality settings of `render`, `view` and `bench`: a preset, then
+/// single overrides.
+#[derive(Parser, Debug, Default, Clone)]
+struct QualityArgs {
+    /// Quality preset: `preview`, `interactive`, `final` or `reference`
+    /// (README.md, "Quality presets"). Replaces all the scene's quality
+    /// settings (spp, max_depth, filter, caustic rays and light samples,
+    /// volume samples); the flags below override single ones.
+    #[arg(long)]
+    preset: Option<Preset>,
+    /// Samples per pixel (overrides the scene's or preset's `image.spp`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: Option<u32>,
+    /// Longest light path in bounces (overrides `image.max_depth`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    max_depth: Option<u32>,
+    /// Texture filtering (overrides `image.filter`): `none` (bilinear lookups
+    /// of the finest mip level; with many samples per pixel, the reference),
+    /// `ray-cones` (EWA lookups over ray-cone footprints, Akenine-Möller et
+    /// al. 2021) or `covariance` (EWA lookups over covariance footprints
+    /// carried along the path).
+    #[arg(long)]
+    filter: Option<FilterMode>,
+    /// Caustic rays per light and light sample (overrides `caustics.rays`; 0
+    /// switches the caustic passes off).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16_777_216))]
+    caustic_rays: Option<u32>,
+    /// Points on each sphere light that emit caustic rays (overrides
+    /// `caustics.light_samples`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    caustic_light_samples: Option<u32>,
+    /// Camera rays per pixel and render sample of the volume pass (overrides
+    /// `volume.samples`; 0 switches the volume pass off).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=65536))]
+    volume_samples: Option<u32>,
 }
 
-impl ProgressLine {
-    fn new(force: bool) -> Self {
-        Self { start: Instant::now(), enabled: force || std::io::stderr().is_terminal(), shown: false }
-    }
-
-    fn update(&mut self, done: u64, total: u64) {
-        let elapsed = self.start.elapsed().as_secs_f64();
-        if !self.enabled || elapsed < 1.0 || total == 0 {
-            return;
+impl QualityArgs {
+    /// Applies the preset, then the single overrides, to `scene`.
+    fn apply(&self, scene: &mut Scene) {
+        if let Some(p) = self.preset {
+            scene.apply_preset(p);
         }
-        let frac = done as f64 / total as f64;
-        let eta = if frac > 0.0 { elapsed * (1.0 - frac) / frac } else { 0.0 };
-        let width = 30;
-        let filled = (frac * width as f64) as usize;
-        eprint!(
-            "\r[{}{}] {:5.1}%  {:.1}s elapsed, {:.1}s left ",
-            "#".repeat(filled),
-            " ".repeat(width - filled),
-            100.0 * frac,
-            elapsed,
-            eta
-        );
-        let _ = std::io::stderr().flush();
-        self.shown = true;
+        let mut q = scene.quality();
+        q.spp = self.spp.unwrap_or(q.spp);
+        q.max_depth = self.max_depth.unwrap_or(q.max_depth);
+        q.filter = self.filter.unwrap_or(q.filter);
+        q.caustic_rays = self.caustic_rays.unwrap_or(q.caustic_rays);
+        q.caustic_light_samples = self.caustic_light_samples.unwrap_or(q.caustic_light_samples);
+        q.volume_samples = self.volume_samples.unwrap_or(q.volume_samples);
+        scene.set_quality(q);
     }
+}
 
-    fn finish(&self) {
-        if self.shown {
-            eprintln!();
-        }
-    }
+/// Reads `path` (or the built-in default scene when `None`).
+fn read_scene(path: Option<&Path>) -> Result<Scene> {
+    Ok(match path {
+        Some(path) => load_scene(path)?,
+        None => parse_scene(DEFAULT_SCENE, DEFAULT_SCENE_NAME)?,
+    })
 }
 
 fn load(args: &RenderArgs) -> Result<Scene> {
-    let mut scene = match &args.scene {
-        Some(path) => load_scene(path)?,
-        None => parse_scene(DEFAULT_SCENE, DEFAULT_SCENE_NAME)?,
-    };
-    if let Some(spp) = args.spp {
-        scene.image.spp = spp;
-    }
+    let mut scene = read_scene(args.scene.as_deref())?;
+    args.quality.apply(&mut scene);
     if let Some(w) = args.width {
         scene.image.width = w;
     }
     if let Some(h) = args.height {
         scene.image.height = h;
-    }
-    if let Some(r) = args.caustic_rays {
-        scene.caustics.rays = r;
-    }
-    if let Some(k) = args.caustic_light_samples {
-        scene.caustics.light_samples = k;
-    }
-    if let Some(n) = args.volume_samples {
-        scene.volume.samples = n;
     }
     if let Some(s) = args.seed {
         scene.image.seed = s;
@@ -283,11 +327,11 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
-    let filter = args.filter.constant();
+    let filter = scene.image.filter.constant();
     let out = if args.bench {
         bench(&ctx, &scene, filter)?
     } else {
-        let mut progress = ProgressLine::new(args.progress);
+        let mut progress = ProgressBar::new(args.progress);
         let variant = quadray::passes::RenderVariant {
             filter,
             caustics: !args.brute_force,
@@ -453,16 +497,11 @@ fn compare(args: CompareArgs) -> Result<()> {
     let read = |path: &Path| -> Result<quadray::passes::RenderOutput> {
         let (width, height, texels) =
             quadray::texture::read_exr_image(path).with_context(|| format!("cannot read {}", path.display()))?;
-        Ok(quadray::passes::RenderOutput {
+        Ok(quadray::passes::RenderOutput::from_radiance(
             width,
             height,
-            radiance: texels.iter().map(|t| [t[0], t[1], t[2]]).collect(),
-            aov: vec![],
-            spp: 0,
-            seconds: 0.0,
-            caustics: None,
-            volume_seconds: None,
-        })
+            texels.iter().map(|t| [t[0], t[1], t[2]]).collect(),
+        ))
     };
     let reference = read(&args.reference)?;
     let test = read(&args.test)?;
@@ -549,6 +588,90 @@ fn filter_bench(args: FilterBenchArgs) -> Result<()> {
     Ok(())
 }
 
+fn view(args: ViewArgs) -> Result<()> {
+    let mut scene = read_scene(args.scene.as_deref())?;
+    if scene.image.preset.is_none() && args.quality.preset.is_none() {
+        // A scene without a preset is viewed at `interactive` quality, its
+        // own explicit settings aside: the scene's spp is meant for a final
+        // render and would make a slow first view.
+        let own = scene.quality();
+        scene.apply_preset(Preset::Interactive);
+        scene.image.max_depth = own.max_depth;
+    }
+    args.quality.apply(&mut scene);
+    if let Some(w) = args.width {
+        scene.image.width = w;
+    }
+    if let Some(h) = args.height {
+        scene.image.height = h;
+    }
+    let script = match &args.script {
+        Some(text) => quadray::viewer::actions::parse_script(text)?,
+        None => Vec::new(),
+    };
+    if !args.screenshot_dir.is_dir() {
+        bail!("--screenshot-dir {}: no such folder", args.screenshot_dir.display());
+    }
+    let name = args
+        .scene
+        .as_ref()
+        .and_then(|p| p.file_stem())
+        .map_or("default".to_string(), |s| s.to_string_lossy().into_owned());
+    let summary = quadray::viewer::run(quadray::viewer::ViewerConfig {
+        scene,
+        name,
+        validation: args.validation,
+        max_spp: args.max_spp,
+        brute_force: args.brute_force,
+        screenshot_dir: args.screenshot_dir.clone(),
+        script,
+    })
+    .context("viewer failed")?;
+    eprintln!("viewer closed after {} frames", summary.frames);
+    if let Some(c) = summary.counters {
+        if c.errors() > 0 {
+            bail!("the validation layer reported {} error(s)", c.errors());
+        }
+    }
+    Ok(())
+}
+
+fn bench_presets(args: BenchArgs) -> Result<()> {
+    let mut scenes = Vec::new();
+    for name in &args.scenes {
+        let (scene_name, source, file) = if name == "default" {
+            ("default".to_string(), DEFAULT_SCENE.to_string(), DEFAULT_SCENE_NAME.to_string())
+        } else {
+            let path = Path::new(name);
+            let text = std::fs::read_to_string(path).with_context(|| format!("cannot read the scene file {name}"))?;
+            let stem = path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            (stem, text, name.clone())
+        };
+        let scene = parse_scene(&source, &file)?;
+        scenes.push(quadray::bench::BenchScene { name: scene_name, scene, source });
+    }
+    let command = std::iter::once("quadray".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
+    let config = quadray::bench::Config {
+        scenes,
+        presets: args.presets,
+        size: (args.width, args.height),
+        reference_spp: args.reference_spp,
+        out_dir: args.out.clone(),
+        command,
+        progress: args.progress,
+    };
+    let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
+    let counters = ctx.counters();
+    let report = quadray::bench::run(&ctx, &config)?;
+    println!("{}", quadray::bench::markdown(&report));
+    eprintln!("wrote {}/bench.json, bench.md and bench.png", args.out.display());
+    drop(ctx);
+    if counters.errors() > 0 {
+        bail!("the validation layer reported {} error(s)", counters.errors());
+    }
+    Ok(())
+}
+
 fn main() -> Result<()> {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
@@ -556,6 +679,8 @@ fn main() -> Result<()> {
         Some(Command::Render(args)) => render(args),
         Some(Command::FilterBench(args)) => filter_bench(args),
         Some(Command::Compare(args)) => compare(args),
+        Some(Command::Bench(args)) => bench_presets(args),
+        Some(Command::View(args)) => view(args),
         None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),
     }
 }

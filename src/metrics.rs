@@ -106,16 +106,7 @@ mod tests {
 
     fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> RenderOutput {
         let radiance = (0..width * height).map(|i| f(i % width, i / width)).collect();
-        RenderOutput {
-            width,
-            height,
-            radiance,
-            aov: vec![],
-            spp: 1,
-            seconds: 0.0,
-            caustics: None,
-            volume_seconds: None,
-        }
+        RenderOutput::from_radiance(width, height, radiance)
     }
 
     #[test]

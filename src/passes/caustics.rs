@@ -21,7 +21,6 @@
 //! they cover.
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use glam::{DVec2, DVec3};
 
@@ -32,7 +31,9 @@ use crate::scene::{Light, Scene};
 use crate::shader_interface::{
     BEAM_STRIDE, CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP,
 };
-use crate::vk::{full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::vk::{
+    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation,
+};
 use crate::{shaders, RenderError};
 
 /// What the caustic passes did, and how long they took.
@@ -44,35 +45,46 @@ pub struct CausticReport {
     pub landed: u64,
     /// Emission grids (lights × light samples).
     pub grids: usize,
-    /// Wall time of the G-buffer pass (s).
+    /// GPU time of the G-buffer pass (s).
     pub gbuffer_seconds: f64,
-    /// Wall time of the caustic-ray pass (s).
+    /// GPU time of the caustic-ray pass (s).
     pub trace_seconds: f64,
-    /// Wall time of the caustic-cell splat pass (s).
+    /// GPU time of the caustic-cell splat pass (s).
     pub splat_seconds: f64,
-    /// Wall time of the volumetric-caustic (beam) pass (s); 0 without fog.
+    /// GPU time of the volumetric-caustic (beam) pass (s); 0 without fog.
     pub beam_seconds: f64,
     /// Caustic irradiance per pixel (W/m², RGB) at the pixel-centre receiver.
     pub irradiance: Vec<[f32; 3]>,
 }
 
 impl CausticReport {
-    /// Total wall time of the caustic passes (s).
+    /// Total GPU time of the caustic passes (s).
     pub fn seconds(&self) -> f64 {
         self.gbuffer_seconds + self.trace_seconds + self.splat_seconds + self.beam_seconds
     }
 }
 
-/// The caustic passes' results that the render pass binds.
+/// The caustic passes: their pipelines, the rays, and the results that the
+/// render pass binds. [`CausticMap::new`] builds them for one image size and
+/// set of emission grids; [`CausticMap::run`] (re)computes the maps for the
+/// camera currently in the frame buffer.
 pub struct CausticMap {
+    gbuffer: ComputePipeline,
+    trace: ComputePipeline,
+    splat: ComputePipeline,
+    beam: ComputePipeline,
+    /// The caustic rays' landing points (`GpuCausticRay`).
+    rays: Buffer,
     /// Receiver per pixel (`GpuReceiver`).
     pub receivers: Buffer,
     /// Fixed-point irradiance per pixel (three `u64`).
     pub map: Buffer,
     /// Fixed-point radiance of the volumetric caustics per pixel (three `u64`).
     pub beams: Buffer,
-    /// True when the beam pass ran (the scene has fog).
+    /// True when the beam pass runs (the scene has fog).
     pub has_beams: bool,
+    grids: Vec<GpuEmitter>,
+    size: (u32, u32),
     /// What was done.
     pub report: CausticReport,
 }
@@ -217,11 +229,29 @@ fn binding_kinds() -> Vec<BindingKind> {
 }
 
 impl CausticMap {
-    /// Runs the three passes for a `width` x `height` image whose frame
-    /// parameters are in `frame` (`GpuFrame`), with `grids` from [`emitters`].
+    /// Runs the passes once for a `width` x `height` image whose frame
+    /// parameters are in `frame` (`GpuFrame`), with `grids` from
+    /// [`emitters`], and reads back the statistics (rays landed, irradiance).
     pub fn compute(
         device: &Arc<Device>,
         cmds: &mut Commands,
+        gpu: &GpuScene,
+        scene: &Scene,
+        frame: &Buffer,
+        size: (u32, u32),
+        grids: &[GpuEmitter],
+    ) -> Result<Self, RenderError> {
+        let timer = GpuTimer::new(device)?;
+        let mut map = Self::new(device, gpu, scene, frame, size, grids)?;
+        map.run(cmds, &timer)?;
+        map.read_statistics();
+        Ok(map)
+    }
+
+    /// Creates the pipelines and buffers for a `width` x `height` image whose
+    /// frame parameters are in `frame`; nothing runs yet.
+    pub fn new(
+        device: &Arc<Device>,
         gpu: &GpuScene,
         scene: &Scene,
         frame: &Buffer,
@@ -276,10 +306,29 @@ impl CausticMap {
         for p in [&gbuffer, &trace, &splat, &beam] {
             p.bind(&bindings);
         }
-        let mut report = CausticReport { rays: ray_count, grids: grids.len(), ..Default::default() };
+        let report = CausticReport { rays: ray_count, grids: grids.len(), ..Default::default() };
+        Ok(Self {
+            gbuffer,
+            trace,
+            splat,
+            beam,
+            rays,
+            receivers,
+            map,
+            beams,
+            has_beams,
+            grids: grids.to_vec(),
+            size: (width, height),
+            report,
+        })
+    }
 
-        let start = Instant::now();
-        cmds.run(|d, cmd| {
+    /// Computes the caustic (and beam) maps for the camera in the frame
+    /// buffer, timing each pass with `timer`.
+    pub fn run(&mut self, cmds: &mut Commands, timer: &GpuTimer) -> Result<(), RenderError> {
+        let (width, height) = self.size;
+        let Self { gbuffer, trace, splat, beam, map, beams, grids, report, .. } = self;
+        let ((), t) = timer.run(cmds, |d, cmd| {
             unsafe {
                 d.cmd_fill_buffer(cmd, map.raw, 0, vk::WHOLE_SIZE, 0);
                 d.cmd_fill_buffer(cmd, beams.raw, 0, vk::WHOLE_SIZE, 0);
@@ -292,48 +341,51 @@ impl CausticMap {
             );
             full_barrier(d, cmd);
         })?;
-        report.gbuffer_seconds = start.elapsed().as_secs_f64();
+        report.gbuffer_seconds = t;
 
-        let start = Instant::now();
-        cmds.run(|d, cmd| {
-            for g in grids {
+        let ((), t) = timer.run(cmds, |d, cmd| {
+            for g in grids.iter() {
                 trace.dispatch(cmd, bytemuck::bytes_of(g), [(g.grid[0] * g.grid[1]).div_ceil(CAUSTIC_GROUP), 1, 1]);
             }
             full_barrier(d, cmd);
         })?;
-        report.trace_seconds = start.elapsed().as_secs_f64();
+        report.trace_seconds = t;
 
-        let start = Instant::now();
-        cmds.run(|d, cmd| {
-            for g in grids {
+        let ((), t) = timer.run(cmds, |d, cmd| {
+            for g in grids.iter() {
                 let cells = (g.grid[0] - 1) * (g.grid[1] - 1);
                 splat.dispatch(cmd, bytemuck::bytes_of(g), [cells.div_ceil(CAUSTIC_GROUP), 1, 1]);
             }
             full_barrier(d, cmd);
         })?;
-        report.splat_seconds = start.elapsed().as_secs_f64();
+        report.splat_seconds = t;
 
-        if has_beams {
-            let start = Instant::now();
-            cmds.run(|d, cmd| {
-                for g in grids {
+        if self.has_beams {
+            let ((), t) = timer.run(cmds, |d, cmd| {
+                for g in grids.iter() {
                     let count = ((g.grid[0] - 1) / BEAM_STRIDE) * ((g.grid[1] - 1) / BEAM_STRIDE);
                     beam.dispatch(cmd, bytemuck::bytes_of(g), [count.div_ceil(CAUSTIC_GROUP).max(1), 1, 1]);
                 }
                 full_barrier(d, cmd);
             })?;
-            report.beam_seconds = start.elapsed().as_secs_f64();
+            report.beam_seconds = t;
         }
+        Ok(())
+    }
 
-        let landed: Vec<GpuCausticRay> = rays.read();
-        report.landed = landed.iter().take(ray_count as usize).filter(|r| r.path != 0).count() as u64;
-        let fixed: Vec<u64> = map.read();
+    /// Reads back how many rays landed and the caustic irradiance per pixel
+    /// into [`CausticMap::report`] (the whole ray buffer and map: tests and
+    /// the command line's summary use them, the viewer does not).
+    pub fn read_statistics(&mut self) {
+        let pixels = self.size.0 as usize * self.size.1 as usize;
+        let landed: Vec<GpuCausticRay> = self.rays.read();
+        self.report.landed = landed.iter().take(self.report.rays as usize).filter(|r| r.path != 0).count() as u64;
+        let fixed: Vec<u64> = self.map.read();
         let scale = 1.0 / CAUSTIC_FIXED_POINT as f64;
-        report.irradiance = fixed
+        self.report.irradiance = fixed
             .chunks_exact(3)
-            .take(pixels as usize)
+            .take(pixels)
             .map(|c| [(c[0] as f64 * scale) as f32, (c[1] as f64 * scale) as f32, (c[2] as f64 * scale) as f32])
             .collect();
-        Ok(Self { receivers, map, beams, has_beams, report })
     }
 }

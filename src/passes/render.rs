@@ -3,16 +3,15 @@
 //! each submission short; progress is reported after each.
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use super::caustics::{emitters, CausticMap, CausticReport};
-use super::gpu::{GpuAov, GpuFrame, GpuMedium, RenderPush};
+use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::volume::VolumeLight;
 use crate::scene::Scene;
 use crate::shader_interface::{FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
 use crate::vk::{
-    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, Image, MemoryLocation,
+    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
 };
 use crate::{shaders, RenderError};
 
@@ -31,12 +30,32 @@ pub struct RenderOutput {
     pub aov: Vec<GpuAov>,
     /// Samples per pixel taken.
     pub spp: u32,
-    /// Wall time of the GPU work in seconds (the caustic and volume passes included).
+    /// GPU time of the work in seconds (timestamps), the caustic and volume
+    /// passes included.
     pub seconds: f64,
+    /// GPU time of the render pass alone (the samples) in seconds.
+    pub render_seconds: f64,
     /// What the caustic passes did, when they ran.
     pub caustics: Option<CausticReport>,
-    /// Wall time of the volume pass (s), when it ran.
+    /// GPU time of the volume pass (s), when it ran.
     pub volume_seconds: Option<f64>,
+}
+
+impl RenderOutput {
+    /// An image without render data (AOVs, times): one read from a file.
+    pub fn from_radiance(width: u32, height: u32, radiance: Vec<[f32; 3]>) -> Self {
+        Self {
+            width,
+            height,
+            radiance,
+            aov: vec![],
+            spp: 0,
+            seconds: 0.0,
+            render_seconds: 0.0,
+            caustics: None,
+            volume_seconds: None,
+        }
+    }
 }
 
 /// Progress of a render: (work done, total work), in tile-samples.
@@ -78,9 +97,21 @@ pub fn render(
     variant: RenderVariant,
     progress: Progress<'_>,
 ) -> Result<RenderOutput, RenderError> {
-    let pixels = width as u64 * height as u64;
+    let mut renderer = Renderer::new(device, cmds, gpu, scene, (width, height, spp), variant)?;
+    renderer.add_samples(cmds, spp, progress)?;
+    let mut out = renderer.output(cmds)?;
+    if let (Some(report), Some(map)) = (&mut out.caustics, &mut renderer.caustics) {
+        map.read_statistics();
+        report.landed = map.report.landed;
+        report.irradiance = std::mem::take(&mut map.report.irradiance);
+    }
+    Ok(out)
+}
+
+/// The camera and image parameters of the shaders' `Frame` block.
+fn gpu_frame(scene: &Scene, gpu: &GpuScene, width: u32, height: u32) -> GpuFrame {
     let [eye, forward, right, up] = camera_basis(scene, width, height);
-    let frame = GpuFrame {
+    GpuFrame {
         // Relative to the GPU frame's origin (the camera, for renders).
         eye: (eye - gpu.origin).as_vec3().to_array(),
         forward: forward.as_vec3().to_array(),
@@ -97,50 +128,259 @@ pub fn render(
         env_height: gpu.environment.map_or(0, |e| e.2),
         env_scale: gpu.environment.map_or(0.0, |e| e.3),
         fog: GpuMedium::from(scene.fog.as_ref()),
-    };
-    let frame_buf = Buffer::with_data(device, "frame", &[frame], vk::BufferUsageFlags::STORAGE_BUFFER)?;
-    let caustics = caustic_map(device, cmds, gpu, scene, &frame_buf, (width, height), variant)?;
-    // Bound in place of the outputs of the passes that did not run.
-    let placeholder =
-        Buffer::new(device, "placeholder", 24, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuOnly)?;
-    let receivers = caustics.as_ref().map_or(&placeholder, |c| &c.receivers);
-    let caustic_map = caustics.as_ref().map_or(&placeholder, |c| &c.map);
-    let beam_map = caustics.as_ref().map_or(&placeholder, |c| &c.beams);
-    let volume = if variant.volume && variant.shading == SHADING_FULL && scene.needs_volume() {
-        Some(VolumeLight::compute(
-            device,
-            cmds,
-            gpu,
-            &frame_buf,
-            (width, height),
-            scene.volume.samples.saturating_mul(spp),
-        )?)
-    } else {
-        None
-    };
-    let volume_radiance = volume.as_ref().map_or(&placeholder, |v| &v.radiance);
-    let accum = Image::new(
-        device,
-        "accumulation",
-        vk::Extent2D { width, height },
-        vk::Format::R32G32B32A32_SFLOAT,
-        vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
-    )?;
-    let readback = Buffer::new(
-        device,
-        "accumulation readback",
-        pixels * 16,
-        vk::BufferUsageFlags::TRANSFER_DST,
-        MemoryLocation::GpuToCpu,
-    )?;
-    let aov = Buffer::new(
-        device,
-        "aov",
-        pixels * std::mem::size_of::<GpuAov>() as u64,
-        vk::BufferUsageFlags::STORAGE_BUFFER,
-        MemoryLocation::GpuToCpu,
-    )?;
+    }
+}
 
+/// A progressive render: the passes a scene needs, built once for an image
+/// size and a [`RenderVariant`], and an accumulation image that samples are
+/// added to. The viewer keeps one and resets it when the camera moves; an
+/// offscreen [`render`] adds all its samples to a fresh one.
+///
+/// The caustic and volume passes run when the renderer is made and after
+/// each [`Renderer::set_camera`], the volume pass with `[volume] samples` ×
+/// `spp` camera rays per pixel, so that a render of `spp` samples gets the
+/// same estimate however it is split.
+pub struct Renderer {
+    // Pipelines first: dropped before the buffers their descriptors name.
+    pipeline: ComputePipeline,
+    caustics: Option<CausticMap>,
+    volume: Option<VolumeLight>,
+    frame: Buffer,
+    // Bound in place of the outputs of passes that do not run; only held.
+    _placeholder: Buffer,
+    accum: Image,
+    readback: Buffer,
+    aov: Buffer,
+    timer: GpuTimer,
+    tiles: Vec<[u32; 4]>,
+    size: (u32, u32),
+    volume_samples: u32,
+    samples: u32,
+    render_seconds: f64,
+}
+
+impl Renderer {
+    /// Builds the passes `scene` needs for a `width` x `height` image (the
+    /// volume pass sized for `spp` samples per pixel), runs the caustic and
+    /// volume passes for the scene's camera, and clears the accumulation.
+    pub fn new(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        gpu: &GpuScene,
+        scene: &Scene,
+        (width, height, spp): (u32, u32, u32),
+        variant: RenderVariant,
+    ) -> Result<Self, RenderError> {
+        let pixels = width as u64 * height as u64;
+        let frame = Buffer::with_data(
+            device,
+            "frame",
+            &[gpu_frame(scene, gpu, width, height)],
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant)?;
+        let volume = if variant.volume && variant.shading == SHADING_FULL && scene.needs_volume() {
+            Some(VolumeLight::new(device, gpu, &frame, (width, height))?)
+        } else {
+            None
+        };
+        // Bound in place of the outputs of the passes that did not run.
+        let placeholder =
+            Buffer::new(device, "placeholder", 24, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuOnly)?;
+        let accum = Image::new(
+            device,
+            "accumulation",
+            vk::Extent2D { width, height },
+            vk::Format::R32G32B32A32_SFLOAT,
+            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
+        )?;
+        let readback = Buffer::new(
+            device,
+            "accumulation readback",
+            pixels * 16,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let aov = Buffer::new(
+            device,
+            "aov",
+            pixels * std::mem::size_of::<GpuAov>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let pipeline = render_pipeline(device, scene, variant, caustics.as_ref(), volume.is_some())?;
+        {
+            let receivers = caustics.as_ref().map_or(&placeholder, |c| &c.receivers);
+            let caustic_map = caustics.as_ref().map_or(&placeholder, |c| &c.map);
+            let beam_map = caustics.as_ref().map_or(&placeholder, |c| &c.beams);
+            let volume_radiance = volume.as_ref().map_or(&placeholder, |v| &v.radiance);
+            let mut bindings = gpu.frame_bindings(&frame);
+            bindings.extend([
+                Binding::Image(&accum),
+                Binding::Buffer(&aov),
+                gpu.texture_binding(),
+                Binding::Buffer(&gpu.env_cdf),
+                Binding::Buffer(receivers),
+                Binding::Buffer(caustic_map),
+                Binding::Buffer(volume_radiance),
+                Binding::Buffer(beam_map),
+            ]);
+            pipeline.bind(&bindings);
+        }
+        cmds.run(|_, cmd| accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL))?;
+        let tiles = (0..height)
+            .step_by(TILE as usize)
+            .flat_map(|y| {
+                (0..width).step_by(TILE as usize).map(move |x| [x, y, TILE.min(width - x), TILE.min(height - y)])
+            })
+            .collect();
+        let mut renderer = Self {
+            pipeline,
+            caustics,
+            volume,
+            frame,
+            _placeholder: placeholder,
+            accum,
+            readback,
+            aov,
+            timer: GpuTimer::new(device)?,
+            tiles,
+            size: (width, height),
+            volume_samples: scene.volume.samples.saturating_mul(spp),
+            samples: 0,
+            render_seconds: 0.0,
+        };
+        renderer.restart(cmds)?;
+        Ok(renderer)
+    }
+
+    /// Moves to `scene`'s camera (and its other frame parameters: seed,
+    /// depth, background, fog): reruns the caustic and volume passes and
+    /// clears the accumulated samples. The scene's objects, lights and
+    /// materials must be those the renderer was built with.
+    pub fn set_camera(&mut self, cmds: &mut Commands, gpu: &GpuScene, scene: &Scene) -> Result<(), RenderError> {
+        let (width, height) = self.size;
+        self.frame.write(0, bytemuck::bytes_of(&gpu_frame(scene, gpu, width, height)));
+        self.restart(cmds)
+    }
+
+    /// Runs the caustic and volume passes and clears the accumulation.
+    fn restart(&mut self, cmds: &mut Commands) -> Result<(), RenderError> {
+        if let Some(c) = &mut self.caustics {
+            c.run(cmds, &self.timer)?;
+        }
+        if let Some(v) = &mut self.volume {
+            v.run(cmds, &self.timer, self.volume_samples)?;
+        }
+        let accum = &self.accum;
+        cmds.run(|d, cmd| {
+            full_barrier(d, cmd);
+            accum.clear(cmd);
+        })?;
+        self.samples = 0;
+        self.render_seconds = 0.0;
+        Ok(())
+    }
+
+    /// Samples per pixel accumulated since the last reset.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Image width and height in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// GPU time of the work since the last reset (s): the caustic and volume
+    /// passes and the samples.
+    pub fn seconds(&self) -> f64 {
+        self.render_seconds
+            + self.caustics.as_ref().map_or(0.0, |c| c.report.seconds())
+            + self.volume_seconds().unwrap_or(0.0)
+    }
+
+    /// GPU time of the volume pass's last run (s), when the pass runs.
+    pub fn volume_seconds(&self) -> Option<f64> {
+        self.volume.as_ref().map(|v| v.seconds)
+    }
+
+    /// Adds `count` samples per pixel, one dispatch per tile and sample,
+    /// reporting progress in tile-samples.
+    pub fn add_samples(&mut self, cmds: &mut Commands, count: u32, progress: Progress<'_>) -> Result<(), RenderError> {
+        let total = self.tiles.len() as u64 * count as u64;
+        let mut done = 0;
+        for sample in self.samples..self.samples + count {
+            for t in &self.tiles {
+                let push = RenderPush {
+                    tile_origin: [t[0], t[1]],
+                    tile_size: [t[2], t[3]],
+                    sample_index: sample,
+                    write_aov: (sample == 0) as u32,
+                };
+                let pipeline = &self.pipeline;
+                let ((), seconds) = self.timer.run(cmds, |d, cmd| {
+                    // Earlier submissions' writes to the accumulation image must be visible.
+                    full_barrier(d, cmd);
+                    pipeline.dispatch(
+                        cmd,
+                        bytemuck::bytes_of(&push),
+                        [t[2].div_ceil(RENDER_GROUP), t[3].div_ceil(RENDER_GROUP), 1],
+                    )
+                })?;
+                self.render_seconds += seconds;
+                done += 1;
+                progress(done, total);
+            }
+        }
+        self.samples += count;
+        Ok(())
+    }
+
+    /// Reads back the mean of the samples so far, the AOVs and the times.
+    pub fn output(&mut self, cmds: &mut Commands) -> Result<RenderOutput, RenderError> {
+        let (width, height) = self.size;
+        let pixels = width as usize * height as usize;
+        let (accum, readback) = (&self.accum, &self.readback);
+        cmds.run(|d, cmd| {
+            full_barrier(d, cmd);
+            accum.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            accum.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback);
+            accum.transition(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL);
+            full_barrier(d, cmd);
+        })?;
+        let sums: Vec<[f32; 4]> = self.readback.read();
+        let radiance = sums[..pixels]
+            .iter()
+            .map(|s| {
+                let n = s[3].max(1.0);
+                [s[0] / n, s[1] / n, s[2] / n]
+            })
+            .collect();
+        let mut aov: Vec<GpuAov> = self.aov.read();
+        aov.truncate(pixels);
+        Ok(RenderOutput {
+            width,
+            height,
+            radiance,
+            aov,
+            spp: self.samples,
+            seconds: self.seconds(),
+            render_seconds: self.render_seconds,
+            caustics: self.caustics.as_ref().map(|c| CausticReport { irradiance: Vec::new(), ..c.report.clone() }),
+            volume_seconds: self.volume_seconds(),
+        })
+    }
+}
+
+/// The render shader specialised for `variant` and the passes that run.
+fn render_pipeline(
+    device: &Arc<Device>,
+    scene: &Scene,
+    variant: RenderVariant,
+    caustics: Option<&CausticMap>,
+    volume: bool,
+) -> Result<ComputePipeline, RenderError> {
     let mut kinds = vec![BindingKind::AccelerationStructure];
     kinds.extend([BindingKind::StorageBuffer; 7]);
     kinds.extend([
@@ -153,7 +393,7 @@ pub fn render(
         BindingKind::StorageBuffer,
         BindingKind::StorageBuffer,
     ]);
-    let pipeline = ComputePipeline::new(
+    Ok(ComputePipeline::new(
         device,
         &shaders::render(),
         &kinds,
@@ -164,78 +404,10 @@ pub fn render(
             variant.filter,
             u32::from(scene.has_media()),
             u32::from(caustics.is_some()),
-            u32::from(volume.is_some()),
-            u32::from(caustics.as_ref().is_some_and(|c| c.has_beams)),
+            u32::from(volume),
+            u32::from(caustics.is_some_and(|c| c.has_beams)),
         ],
-    )?;
-    let mut bindings = gpu.frame_bindings(&frame_buf);
-    bindings.extend([
-        Binding::Image(&accum),
-        Binding::Buffer(&aov),
-        gpu.texture_binding(),
-        Binding::Buffer(&gpu.env_cdf),
-        Binding::Buffer(receivers),
-        Binding::Buffer(caustic_map),
-        Binding::Buffer(volume_radiance),
-        Binding::Buffer(beam_map),
-    ]);
-    pipeline.bind(&bindings);
-
-    let tiles: Vec<[u32; 4]> = (0..height)
-        .step_by(TILE as usize)
-        .flat_map(|y| (0..width).step_by(TILE as usize).map(move |x| [x, y, TILE.min(width - x), TILE.min(height - y)]))
-        .collect();
-    let total = tiles.len() as u64 * spp as u64;
-    cmds.run(|_, cmd| {
-        accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
-        accum.clear(cmd);
-    })?;
-    let start = Instant::now();
-    let mut done = 0;
-    for sample in 0..spp {
-        for t in &tiles {
-            let push = RenderPush {
-                tile_origin: [t[0], t[1]],
-                tile_size: [t[2], t[3]],
-                sample_index: sample,
-                write_aov: (sample == 0) as u32,
-            };
-            cmds.run(|d, cmd| {
-                // Earlier submissions' writes to the accumulation image must be visible.
-                full_barrier(d, cmd);
-                pipeline.dispatch(
-                    cmd,
-                    bytemuck::bytes_of(&push),
-                    [t[2].div_ceil(RENDER_GROUP), t[3].div_ceil(RENDER_GROUP), 1],
-                )
-            })?;
-            done += 1;
-            progress(done, total);
-        }
-    }
-    let report = caustics.map(|c| c.report);
-    let volume_seconds = volume.as_ref().map(|v| v.seconds);
-    let seconds = start.elapsed().as_secs_f64()
-        + report.as_ref().map_or(0.0, CausticReport::seconds)
-        + volume_seconds.unwrap_or(0.0);
-
-    cmds.run(|d, cmd| {
-        full_barrier(d, cmd);
-        accum.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-        accum.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, &readback);
-        full_barrier(d, cmd);
-    })?;
-    let sums: Vec<[f32; 4]> = readback.read();
-    let radiance = sums[..pixels as usize]
-        .iter()
-        .map(|s| {
-            let n = s[3].max(1.0);
-            [s[0] / n, s[1] / n, s[2] / n]
-        })
-        .collect();
-    let mut aovs: Vec<GpuAov> = aov.read();
-    aovs.truncate(pixels as usize);
-    Ok(RenderOutput { width, height, radiance, aov: aovs, spp, seconds, caustics: report, volume_seconds })
+    )?)
 }
 
 /// Runs the caustic passes when `variant` asks for them and the scene needs
@@ -244,7 +416,6 @@ pub fn render(
 /// receiver and a light (max_depth ≥ 3).
 fn caustic_map(
     device: &Arc<Device>,
-    cmds: &mut Commands,
     gpu: &GpuScene,
     scene: &Scene,
     frame: &Buffer,
@@ -257,9 +428,27 @@ fn caustic_map(
     }
     // A caustic path from the camera: the receiver (a bounce), the specular
     // vertices (a bounce each), then the light found by the next segment.
-    let Some(grids) = emitters(scene, gpu.origin, max_depth - 2) else {
+    let Some(mut grids) = emitters(scene, gpu.origin, max_depth - 2) else {
         log::warn!("a light is inside the bounds of the specular objects: caustics are left to the path tracer");
         return Ok(None);
     };
-    Ok(Some(CausticMap::compute(device, cmds, gpu, scene, frame, size, &grids)?))
+    // The ray buffer is one storage buffer: fewer rays per grid when all of
+    // them would not fit in the device's largest binding.
+    let ray_bytes = std::mem::size_of::<GpuCausticRay>() as u64;
+    let fits = device.properties.limits.max_storage_buffer_range as u64 / ray_bytes;
+    let total = |g: &[GpuEmitter]| g.iter().map(|e| e.grid[0] as u64 * e.grid[1] as u64).sum::<u64>();
+    if total(&grids) > fits {
+        let asked = total(&grids);
+        let mut fewer = scene.clone();
+        let scale = fits as f64 / asked as f64;
+        fewer.caustics.rays = ((scene.caustics.rays as f64 * scale * 0.95) as u32).max(1);
+        grids = emitters(&fewer, gpu.origin, max_depth - 2).unwrap_or_default();
+        log::warn!(
+            "{asked} caustic rays do not fit in one storage buffer of this device ({fits} rays); tracing {} \
+             ({} per light and light sample)",
+            total(&grids),
+            fewer.caustics.rays
+        );
+    }
+    Ok(Some(CausticMap::new(device, gpu, scene, frame, size, &grids)?))
 }

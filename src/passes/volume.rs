@@ -6,35 +6,51 @@
 //! pass adds its per-pixel mean and leaves that part out of its own estimate.
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use super::scene_gpu::GpuScene;
 use crate::shader_interface::{INTERSECT_FULL, RENDER_GROUP};
-use crate::vk::{full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::vk::{
+    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation,
+};
 use crate::{shaders, RenderError};
 
 /// Camera rays per pixel in one dispatch of the volume pass.
 pub const BATCH: u32 = 16;
 
-/// The volume pass's output: in-scattered radiance per pixel.
+/// The volume pass: its pipeline and its output, in-scattered radiance per
+/// pixel. [`VolumeLight::new`] builds it for one image size;
+/// [`VolumeLight::run`] (re)computes it for the camera in the frame buffer.
 pub struct VolumeLight {
+    pipeline: ComputePipeline,
     /// Mean in-scattered radiance per pixel (three `f32`).
     pub radiance: Buffer,
-    /// Wall time of the pass (s).
+    size: (u32, u32),
+    /// GPU time of the last run (s).
     pub seconds: f64,
 }
 
 impl VolumeLight {
-    /// Runs the pass for a `width` x `height` image whose frame parameters
-    /// are in `frame` (`GpuFrame`), with `samples` camera rays per pixel
-    /// (dispatched in batches of at most [`BATCH`]).
+    /// Builds the pass and runs it once (see [`VolumeLight::run`]).
     pub fn compute(
         device: &Arc<Device>,
         cmds: &mut Commands,
         gpu: &GpuScene,
         frame: &Buffer,
-        (width, height): (u32, u32),
+        size: (u32, u32),
         samples: u32,
+    ) -> Result<Self, RenderError> {
+        let mut pass = Self::new(device, gpu, frame, size)?;
+        pass.run(cmds, &GpuTimer::new(device)?, samples)?;
+        Ok(pass)
+    }
+
+    /// Creates the pipeline and the output for a `width` x `height` image
+    /// whose frame parameters are in `frame` (`GpuFrame`); nothing runs yet.
+    pub fn new(
+        device: &Arc<Device>,
+        gpu: &GpuScene,
+        frame: &Buffer,
+        (width, height): (u32, u32),
     ) -> Result<Self, RenderError> {
         let radiance = Buffer::new(
             device,
@@ -49,20 +65,30 @@ impl VolumeLight {
         let mut bindings = gpu.frame_bindings(frame);
         bindings.push(Binding::Buffer(&radiance));
         pipeline.bind(&bindings);
-        let start = Instant::now();
-        cmds.run(|d, cmd| unsafe { d.cmd_fill_buffer(cmd, radiance.raw, 0, vk::WHOLE_SIZE, 0) })?;
+        Ok(Self { pipeline, radiance, size: (width, height), seconds: 0.0 })
+    }
+
+    /// Computes the in-scattered radiance with `samples` camera rays per
+    /// pixel (dispatched in batches of at most [`BATCH`]).
+    pub fn run(&mut self, cmds: &mut Commands, timer: &GpuTimer, samples: u32) -> Result<(), RenderError> {
+        let (width, height) = self.size;
+        let radiance = &self.radiance;
+        let ((), mut seconds) =
+            timer.run(cmds, |d, cmd| unsafe { d.cmd_fill_buffer(cmd, radiance.raw, 0, vk::WHOLE_SIZE, 0) })?;
         for first in (0..samples).step_by(BATCH as usize) {
             let push = [first, BATCH.min(samples - first), samples];
-            cmds.run(|d, cmd| {
+            let ((), t) = timer.run(cmds, |d, cmd| {
                 full_barrier(d, cmd);
-                pipeline.dispatch(
+                self.pipeline.dispatch(
                     cmd,
                     bytemuck::bytes_of(&push),
                     [width.div_ceil(RENDER_GROUP), height.div_ceil(RENDER_GROUP), 1],
                 );
                 full_barrier(d, cmd);
             })?;
+            seconds += t;
         }
-        Ok(Self { radiance, seconds: start.elapsed().as_secs_f64() })
+        self.seconds = seconds;
+        Ok(())
     }
 }

@@ -32,9 +32,9 @@ use toml::Spanned;
 use crate::hash::hash_unit;
 
 use super::{
-    Camera, CausticSettings, ConductorFresnel, EnvironmentMapSettings, ImageSettings, Light, Material, MaterialKind,
-    MaterialMaps, Medium, Scene, SceneObject, TextureImage, UvMapping, UvSettings, VolumeSettings,
-    DEFAULT_CAUSTIC_LIGHT_SAMPLES, DEFAULT_CAUSTIC_RAYS, DEFAULT_VOLUME_SAMPLES,
+    Camera, CausticSettings, ConductorFresnel, EnvironmentMapSettings, FilterMode, ImageSettings, Light, Material,
+    MaterialKind, MaterialMaps, Medium, Preset, Quality, Scene, SceneObject, TextureImage, UvMapping, UvSettings,
+    VolumeSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 use crate::sampling::envmap::procedural_sky;
@@ -742,6 +742,8 @@ struct RawImage {
     seed: Option<Seed>,
     exposure: Option<Exposure>,
     max_depth: Option<Depth>,
+    preset: Option<Spanned<String>>,
+    filter: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -1116,13 +1118,25 @@ struct RawLight {
 
 fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
     let image = raw.image.as_ref();
+    let preset = match image.and_then(|i| i.preset.as_ref()) {
+        Some(p) => Some(p.get_ref().parse::<Preset>().map_err(|e| src.error(Some(p.span()), "image.preset", e))?),
+        None => None,
+    };
+    // A preset sets every quality setting; the file's own keys override it.
+    let quality = preset.map_or_else(Quality::default, Preset::quality);
+    let filter = match image.and_then(|i| i.filter.as_ref()) {
+        Some(f) => f.get_ref().parse::<FilterMode>().map_err(|e| src.error(Some(f.span()), "image.filter", e))?,
+        None => quality.filter,
+    };
     let image = ImageSettings {
         width: image.and_then(|i| i.width).map_or(640, |v| v.get() as u32),
         height: image.and_then(|i| i.height).map_or(480, |v| v.get() as u32),
-        spp: image.and_then(|i| i.spp).map_or(16, |v| v.get() as u32),
+        spp: image.and_then(|i| i.spp).map_or(quality.spp, |v| v.get() as u32),
         seed: image.and_then(|i| i.seed).map_or(0, |v| v.get() as u32),
         exposure: image.and_then(|i| i.exposure).map_or(0.0, |v| v.get() as f32),
-        max_depth: image.and_then(|i| i.max_depth).map_or(DEFAULT_MAX_DEPTH, |v| v.get() as u32),
+        max_depth: image.and_then(|i| i.max_depth).map_or(quality.max_depth, |v| v.get() as u32),
+        filter,
+        preset,
     };
     let camera = build_camera(src, &raw.camera)?;
     if let (Some(background), Some(environment)) = (&raw.background, &raw.environment) {
@@ -1208,11 +1222,11 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
     let fog = raw.fog.as_ref().map(|f| f.get_ref().build());
     let caustics = raw.caustics.as_ref();
     let caustics = CausticSettings {
-        rays: caustics.and_then(|c| c.rays).map_or(DEFAULT_CAUSTIC_RAYS, |v| v.get() as u32),
-        light_samples: caustics.and_then(|c| c.light_samples).map_or(DEFAULT_CAUSTIC_LIGHT_SAMPLES, |v| v.get() as u32),
+        rays: caustics.and_then(|c| c.rays).map_or(quality.caustic_rays, |v| v.get() as u32),
+        light_samples: caustics.and_then(|c| c.light_samples).map_or(quality.caustic_light_samples, |v| v.get() as u32),
     };
     let volume = VolumeSettings {
-        samples: raw.volume.as_ref().and_then(|v| v.samples).map_or(DEFAULT_VOLUME_SAMPLES, |v| v.get() as u32),
+        samples: raw.volume.as_ref().and_then(|v| v.samples).map_or(quality.volume_samples, |v| v.get() as u32),
     };
     Ok(Scene {
         volume,
@@ -2133,7 +2147,19 @@ mod tests {
     #[test]
     fn defaults() {
         let s = parse("");
-        assert_eq!(s.image, ImageSettings { width: 640, height: 480, spp: 16, seed: 0, exposure: 0.0, max_depth: 6 });
+        assert_eq!(
+            s.image,
+            ImageSettings {
+                width: 640,
+                height: 480,
+                spp: 16,
+                seed: 0,
+                exposure: 0.0,
+                max_depth: 6,
+                filter: FilterMode::None,
+                preset: None
+            }
+        );
         assert_eq!(s.camera.up, DVec3::Y);
         assert_eq!(s.camera.vfov_degrees, 40.0);
         assert_eq!(s.background, Vec3::ZERO);
@@ -2146,7 +2172,16 @@ mod tests {
         let s = parse_scene(&format!("{text}{CAMERA}"), "t.toml").unwrap();
         assert_eq!(
             s.image,
-            ImageSettings { width: 64, height: 48, spp: 3, seed: 4_000_000_000, exposure: -1.5, max_depth: 12 }
+            ImageSettings {
+                width: 64,
+                height: 48,
+                spp: 3,
+                seed: 4_000_000_000,
+                exposure: -1.5,
+                max_depth: 12,
+                filter: FilterMode::None,
+                preset: None
+            }
         );
         assert_eq!(s.background, Vec3::new(0.1, 0.2, 0.3));
     }

@@ -3,12 +3,14 @@
 //! TOML (documented field by field in `scenes/README.md`).
 
 pub mod file;
+pub mod preset;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
 
 use crate::geometry::FunctionalObject;
 
 pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+pub use preset::{FilterMode, Preset, Quality};
 
 /// A pinhole camera.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,6 +40,11 @@ pub struct ImageSettings {
     pub exposure: f32,
     /// Longest light path, in bounces (1 = direct lighting only).
     pub max_depth: u32,
+    /// Texture filtering.
+    pub filter: FilterMode,
+    /// The quality preset the settings started from, if any (the scene
+    /// file's or the command line's; explicit settings may override parts).
+    pub preset: Option<Preset>,
 }
 
 /// How a surface scatters light.

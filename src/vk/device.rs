@@ -106,6 +106,24 @@ fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String>
     missing
 }
 
+/// What one physical device lacks to present to `surface` from its first
+/// compute queue family (the one [`Device`] uses).
+fn surface_shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice, surface: &super::Surface) -> Vec<String> {
+    let mut missing = Vec::new();
+    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    if !exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == ash::khr::swapchain::NAME).unwrap_or(false)) {
+        missing.push("VK_KHR_swapchain".to_string());
+    }
+    let family = unsafe { instance.get_physical_device_queue_family_properties(pd) }
+        .iter()
+        .position(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE));
+    let presents = family.is_some_and(|f| surface.supports_presenting(pd, f as u32));
+    if !presents {
+        missing.push("presenting to the window from its compute queue".to_string());
+    }
+    missing
+}
+
 fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
     props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_else(|_| "?".into())
 }
@@ -115,6 +133,17 @@ impl Device {
     /// GPUs, then integrated, then software) and creates a logical device.
     /// When none fits, the error lists every device seen and what it lacks.
     pub fn new(instance: Arc<Instance>) -> Result<Arc<Self>, VkError> {
+        Self::select(instance, None)
+    }
+
+    /// [`Device::new`] for presenting to `surface`: the device must also
+    /// support the swapchain extension and presenting to the surface from
+    /// its compute queue.
+    pub fn for_surface(instance: Arc<Instance>, surface: &super::Surface) -> Result<Arc<Self>, VkError> {
+        Self::select(instance, Some(surface))
+    }
+
+    fn select(instance: Arc<Instance>, surface: Option<&super::Surface>) -> Result<Arc<Self>, VkError> {
         let raw_instance = &instance.raw;
         let devices = unsafe { raw_instance.enumerate_physical_devices() }.map_err(|e| {
             VkError::NoSuitableDevice(format!("the Vulkan driver lists no devices ({e}).\nTo fix: {SETUP_HINT}"))
@@ -123,7 +152,10 @@ impl Device {
         let mut fits = Vec::new();
         for &pd in &devices {
             let props = unsafe { raw_instance.get_physical_device_properties(pd) };
-            let missing = shortcomings(raw_instance, pd);
+            let mut missing = shortcomings(raw_instance, pd);
+            if let Some(surface) = surface {
+                missing.extend(surface_shortcomings(raw_instance, pd, surface));
+            }
             let name = device_name(&props);
             if missing.is_empty() {
                 let rank = match props.device_type {
@@ -142,10 +174,10 @@ impl Device {
             let seen = if report.is_empty() { "  (no Vulkan devices)".to_string() } else { report.join("\n") };
             return Err(VkError::NoSuitableDevice(format!("devices seen:\n{seen}\nTo fix: {SETUP_HINT}")));
         };
-        Self::create(instance.clone(), physical)
+        Self::create(instance.clone(), physical, surface.is_some())
     }
 
-    fn create(instance: Arc<Instance>, physical: vk::PhysicalDevice) -> Result<Arc<Self>, VkError> {
+    fn create(instance: Arc<Instance>, physical: vk::PhysicalDevice, swapchain: bool) -> Result<Arc<Self>, VkError> {
         let raw_instance = &instance.raw;
         let properties = unsafe { raw_instance.get_physical_device_properties(physical) };
         let queue_family = unsafe { raw_instance.get_physical_device_queue_family_properties(physical) }
@@ -155,7 +187,10 @@ impl Device {
         let priorities = [1.0f32];
         let queue_info =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
-        let ext_names: Vec<_> = REQUIRED_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
+        let mut ext_names: Vec<_> = REQUIRED_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
+        if swapchain {
+            ext_names.push(ash::khr::swapchain::NAME.as_ptr());
+        }
 
         let mut supported12 = vk::PhysicalDeviceVulkan12Features::default();
         let mut supported = vk::PhysicalDeviceFeatures2::default().push_next(&mut supported12);

@@ -46,6 +46,11 @@ impl Instance {
     /// Creates a Vulkan 1.2 instance; with `validation`, enables the Khronos
     /// validation layer (failing if it is not installed) and a messenger.
     pub fn new(validation: bool) -> Result<Self, VkError> {
+        Self::with_extensions(validation, &[])
+    }
+
+    /// [`Instance::new`] with extra instance extensions (a window surface's).
+    pub fn with_extensions(validation: bool, extra: &[*const std::ffi::c_char]) -> Result<Self, VkError> {
         let entry = unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))?;
         let app = vk::ApplicationInfo::default()
             .application_name(c"quadray")
@@ -53,7 +58,7 @@ impl Instance {
             .api_version(vk::API_VERSION_1_2);
 
         let mut layers = Vec::new();
-        let mut extensions = Vec::new();
+        let mut extensions = extra.to_vec();
         if validation {
             let available = unsafe { entry.enumerate_instance_layer_properties() }?;
             let found =

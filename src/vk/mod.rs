@@ -11,6 +11,8 @@ mod image;
 mod instance;
 mod pipeline;
 mod sampler;
+mod surface;
+mod swapchain;
 mod timestamps;
 
 use std::sync::Arc;
@@ -25,7 +27,9 @@ pub use image::Image;
 pub use instance::{Instance, ValidationCounters};
 pub use pipeline::{Binding, BindingKind, ComputePipeline};
 pub use sampler::Sampler;
-pub use timestamps::Timestamps;
+pub use surface::{surface_extensions, Surface};
+pub use swapchain::{PresentResult, Swapchain};
+pub use timestamps::{GpuTimer, Timestamps};
 
 /// Errors from the Vulkan backend.
 #[derive(Debug, thiserror::Error)]

@@ -52,3 +52,55 @@ impl Drop for Timestamps {
         unsafe { self.device.raw.destroy_query_pool(self.pool, None) };
     }
 }
+
+/// Times submitted work on the GPU: a timestamp before and after it. Falls
+/// back to the wall time of the (synchronous) submission on a queue without
+/// timestamps.
+pub struct GpuTimer {
+    stamps: Option<Timestamps>,
+}
+
+impl GpuTimer {
+    /// A timer on `device`'s queue.
+    pub fn new(device: &Arc<Device>) -> Result<Self, VkError> {
+        let families = unsafe { device.instance.raw.get_physical_device_queue_family_properties(device.physical) };
+        let valid_bits = families.get(device.queue_family as usize).map_or(0, |f| f.timestamp_valid_bits);
+        let stamps = if valid_bits > 0 { Some(Timestamps::new(device, 2)?) } else { None };
+        Ok(Self { stamps })
+    }
+
+    /// True when times come from GPU timestamps (not wall clocks).
+    pub fn is_gpu(&self) -> bool {
+        self.stamps.is_some()
+    }
+
+    /// Records work with `record`, submits it, waits, and returns the
+    /// result and the work's duration in seconds.
+    pub fn run<R>(
+        &self,
+        cmds: &mut super::Commands,
+        record: impl FnOnce(&ash::Device, vk::CommandBuffer) -> R,
+    ) -> Result<(R, f64), VkError> {
+        let start = std::time::Instant::now();
+        let out = cmds.run(|d, cmd| {
+            if let Some(s) = &self.stamps {
+                s.reset(cmd);
+                s.write(cmd, 0);
+            }
+            let out = record(d, cmd);
+            if let Some(s) = &self.stamps {
+                s.write(cmd, 1);
+            }
+            out
+        })?;
+        let wall = start.elapsed().as_secs_f64();
+        let seconds = match &self.stamps {
+            Some(s) => {
+                let ns = s.read_ns()?;
+                (ns[1] - ns[0]).max(0.0) * 1e-9
+            }
+            None => wall,
+        };
+        Ok((out, seconds))
+    }
+}

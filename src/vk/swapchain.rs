@@ -1,0 +1,230 @@
+//! A swapchain presenting 8-bit pixels that the host writes: each frame is
+//! copied from a host-visible buffer into the acquired image, then presented.
+//!
+//! The viewer's frames are tone-mapped on the host (the same code as the PNG
+//! output), so the presented pixels and a screenshot's are the same bytes.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{full_barrier, Buffer, Commands, Device, MemoryLocation, Surface, VkError};
+
+/// What [`Swapchain::present`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PresentResult {
+    /// Presented and still matching the window.
+    Presented,
+    /// The swapchain no longer matches the window (resized): recreate it.
+    OutOfDate,
+}
+
+/// A swapchain of `TRANSFER_DST` images and a staging buffer for one frame.
+pub struct Swapchain {
+    device: Arc<Device>,
+    loader: ash::khr::swapchain::Device,
+    raw: vk::SwapchainKHR,
+    images: Vec<vk::Image>,
+    /// Image size in pixels.
+    pub extent: vk::Extent2D,
+    /// Pixel format of the images (8 bits per channel, RGBA or BGRA order).
+    pub format: vk::Format,
+    staging: Buffer,
+    acquired: vk::Fence,
+}
+
+impl Swapchain {
+    /// Creates a swapchain on `surface` of about `width` x `height` pixels
+    /// (the surface's own extent wins when it has one); `None` when the
+    /// surface has no area (a minimised window).
+    pub fn new(device: &Arc<Device>, surface: &Surface, (width, height): (u32, u32)) -> Result<Option<Self>, VkError> {
+        let pd = device.physical;
+        let caps = unsafe { surface.loader.get_physical_device_surface_capabilities(pd, surface.raw) }?;
+        let extent = if caps.current_extent.width != u32::MAX {
+            caps.current_extent
+        } else {
+            vk::Extent2D {
+                width: width.clamp(caps.min_image_extent.width, caps.max_image_extent.width),
+                height: height.clamp(caps.min_image_extent.height, caps.max_image_extent.height),
+            }
+        };
+        if extent.width == 0 || extent.height == 0 {
+            return Ok(None);
+        }
+        if !caps.supported_usage_flags.contains(vk::ImageUsageFlags::TRANSFER_DST) {
+            return Err(VkError::Vk(vk::Result::ERROR_FEATURE_NOT_PRESENT));
+        }
+        let formats = unsafe { surface.loader.get_physical_device_surface_formats(pd, surface.raw) }?;
+        let byte_formats = [
+            vk::Format::B8G8R8A8_UNORM,
+            vk::Format::R8G8B8A8_UNORM,
+            vk::Format::B8G8R8A8_SRGB,
+            vk::Format::R8G8B8A8_SRGB,
+        ];
+        let chosen = byte_formats
+            .iter()
+            .find_map(|f| formats.iter().find(|s| s.format == *f))
+            .copied()
+            .ok_or(VkError::Vk(vk::Result::ERROR_FORMAT_NOT_SUPPORTED))?;
+        let modes = unsafe { surface.loader.get_physical_device_surface_present_modes(pd, surface.raw) }?;
+        // Mailbox never blocks on a display refresh; FIFO is always there.
+        let mode = if modes.contains(&vk::PresentModeKHR::MAILBOX) {
+            vk::PresentModeKHR::MAILBOX
+        } else {
+            vk::PresentModeKHR::FIFO
+        };
+        let mut count = caps.min_image_count + 1;
+        if caps.max_image_count > 0 {
+            count = count.min(caps.max_image_count);
+        }
+        let info = vk::SwapchainCreateInfoKHR::default()
+            .surface(surface.raw)
+            .min_image_count(count)
+            .image_format(chosen.format)
+            .image_color_space(chosen.color_space)
+            .image_extent(extent)
+            .image_array_layers(1)
+            .image_usage(vk::ImageUsageFlags::TRANSFER_DST)
+            .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .pre_transform(caps.current_transform)
+            .composite_alpha(vk::CompositeAlphaFlagsKHR::OPAQUE)
+            .present_mode(mode)
+            .clipped(true);
+        let loader = ash::khr::swapchain::Device::new(&device.instance.raw, &device.raw);
+        let raw = unsafe { loader.create_swapchain(&info, None) }?;
+        let images = match unsafe { loader.get_swapchain_images(raw) } {
+            Ok(i) => i,
+            Err(e) => {
+                unsafe { loader.destroy_swapchain(raw, None) };
+                return Err(e.into());
+            }
+        };
+        let acquired = unsafe { device.raw.create_fence(&vk::FenceCreateInfo::default(), None) };
+        let acquired = match acquired {
+            Ok(f) => f,
+            Err(e) => {
+                unsafe { loader.destroy_swapchain(raw, None) };
+                return Err(e.into());
+            }
+        };
+        let staging = Buffer::new(
+            device,
+            "swapchain staging",
+            extent.width as u64 * extent.height as u64 * 4,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        );
+        let staging = match staging {
+            Ok(b) => b,
+            Err(e) => {
+                unsafe {
+                    device.raw.destroy_fence(acquired, None);
+                    loader.destroy_swapchain(raw, None);
+                }
+                return Err(e);
+            }
+        };
+        log::info!(
+            "swapchain: {}x{} {:?}, {:?}, {} images",
+            extent.width,
+            extent.height,
+            chosen.format,
+            mode,
+            images.len()
+        );
+        Ok(Some(Self { device: device.clone(), loader, raw, images, extent, format: chosen.format, staging, acquired }))
+    }
+
+    /// Presents `rgba` (8-bit sRGB-encoded RGBA, row 0 at the top, exactly
+    /// the swapchain's extent) in the next image.
+    pub fn present(&mut self, cmds: &mut Commands, rgba: &[u8]) -> Result<PresentResult, VkError> {
+        let (w, h) = (self.extent.width as usize, self.extent.height as usize);
+        assert_eq!(rgba.len(), w * h * 4, "frame size does not match the swapchain");
+        let acquire =
+            unsafe { self.loader.acquire_next_image(self.raw, u64::MAX, vk::Semaphore::null(), self.acquired) };
+        let index = match acquire {
+            Ok((index, _suboptimal)) => index,
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => return Ok(PresentResult::OutOfDate),
+            Err(e) => return Err(e.into()),
+        };
+        unsafe {
+            self.device.raw.wait_for_fences(&[self.acquired], true, u64::MAX)?;
+            self.device.raw.reset_fences(&[self.acquired])?;
+        }
+        if matches!(self.format, vk::Format::B8G8R8A8_UNORM | vk::Format::B8G8R8A8_SRGB) {
+            let mut bgra = rgba.to_vec();
+            for p in bgra.chunks_exact_mut(4) {
+                p.swap(0, 2);
+            }
+            self.staging.write(0, &bgra);
+        } else {
+            self.staging.write(0, rgba);
+        }
+        let image = self.images[index as usize];
+        let (staging, extent) = (&self.staging, self.extent);
+        cmds.run(|d, cmd| {
+            full_barrier(d, cmd);
+            transition(d, cmd, image, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 });
+            unsafe {
+                d.cmd_copy_buffer_to_image(cmd, staging.raw, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &[region])
+            };
+            transition(d, cmd, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR);
+        })?;
+        // The copy has finished (Commands::run waited): no semaphore needed.
+        let swapchains = [self.raw];
+        let indices = [index];
+        let info = vk::PresentInfoKHR::default().swapchains(&swapchains).image_indices(&indices);
+        match unsafe { self.loader.queue_present(self.device.queue, &info) } {
+            Ok(false) => Ok(PresentResult::Presented),
+            Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => Ok(PresentResult::OutOfDate),
+            Err(e) => Err(e.into()),
+        }
+    }
+}
+
+fn transition(d: &ash::Device, cmd: vk::CommandBuffer, image: vk::Image, from: vk::ImageLayout, to: vk::ImageLayout) {
+    let barrier = vk::ImageMemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+        .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::MEMORY_READ)
+        .old_layout(from)
+        .new_layout(to)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        });
+    unsafe {
+        d.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[],
+            &[barrier],
+        )
+    };
+}
+
+impl Drop for Swapchain {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.raw.device_wait_idle();
+            self.device.raw.destroy_fence(self.acquired, None);
+            self.loader.destroy_swapchain(self.raw, None);
+        }
+    }
+}
