@@ -2167,6 +2167,30 @@ mod tests {
     }
 
     #[test]
+    fn presets_set_the_quality_and_the_files_keys_override_them() {
+        let s = parse_scene(
+            &format!("[image]\npreset = \"final\"\nmax_depth = 10\n[volume]\nsamples = 3\n{CAMERA}"),
+            "t.toml",
+        )
+        .unwrap();
+        let q = Preset::Final.quality();
+        assert_eq!(s.image.preset, Some(Preset::Final));
+        assert_eq!((s.image.spp, s.image.filter, s.caustics.rays), (q.spp, q.filter, q.caustic_rays));
+        assert_eq!((s.image.max_depth, s.volume.samples), (10, 3));
+        let s = parse_scene(&format!("[image]\nfilter = \"ray-cones\"\n{CAMERA}"), "t.toml").unwrap();
+        assert_eq!((s.image.filter, s.image.preset, s.image.spp), (FilterMode::RayCones, None, 16));
+    }
+
+    #[test]
+    fn unknown_presets_and_filters_are_errors_at_their_line() {
+        let e = parse_scene(&format!("[image]\npreset = \"fast\"\n{CAMERA}"), "t.toml").unwrap_err().to_string();
+        assert!(e.starts_with("t.toml:2:10: image.preset: unknown preset `fast`"), "{e}");
+        let e =
+            parse_scene(&format!("[image]\nwidth = 8\nfilter = \"ewa\"\n{CAMERA}"), "t.toml").unwrap_err().to_string();
+        assert!(e.starts_with("t.toml:3:10: image.filter: unknown filter `ewa`"), "{e}");
+    }
+
+    #[test]
     fn image_and_background() {
         let text = "background = [0.1, 0.2, 0.3]\n[image]\nwidth = 64\nheight = 48\nspp = 3\nseed = 4000000000\nexposure = -1.5\nmax_depth = 12\n";
         let s = parse_scene(&format!("{text}{CAMERA}"), "t.toml").unwrap();
