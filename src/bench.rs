@@ -101,7 +101,8 @@ pub struct Row {
     pub volume_seconds: f64,
     /// GPU time of all passes, s.
     pub gpu_seconds: f64,
-    /// Wall time of the render call (upload excluded), s.
+    /// Wall time of the render call (pipeline and buffer creation, passes,
+    /// read-back; the scene upload excluded), s.
     pub wall_seconds: f64,
     /// Mean FLIP against the reference (0 for the reference itself).
     pub flip: f64,

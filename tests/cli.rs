@@ -514,3 +514,68 @@ fn quadray_validation_in_the_environment_asks_for_the_layer() {
     render_ok(&args, outdir.path(), &[("QUADRAY_VALIDATION", "0"), ("VK_LAYER_PATH", no_layers)]);
     assert_eq!(entries(outdir.path()), ["out.exr", "out.png"]);
 }
+
+#[test]
+fn presets_apply_and_single_flags_override_them() {
+    let outdir = tempfile::tempdir().unwrap();
+    let dir = outdir.path();
+    let scene = write_scene(dir, "s.toml", &SPHERE_SCENE.replace("spp = 25656", "preset = \"final\"\nspp = 5"));
+    let out = dir.join("a.exr");
+    // The file's preset (final, 64 spp) is replaced by --preset preview
+    // (1 spp), whose spp --spp overrides.
+    let log = render_ok(
+        &["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--preset", "preview", "--spp", "3"],
+        dir,
+        &[("QUADRAY_VALIDATION", "1")],
+    );
+    assert!(log.contains("(40x30, 3 spp,"), "{log}");
+    // The file's own spp overrides the file's preset.
+    let log = render_ok(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--filter", "covariance"], dir, &[]);
+    assert!(log.contains("(40x30, 5 spp,"), "{log}");
+    let err = render_fails(&["render", scene.to_str().unwrap(), "--preset", "fast"], dir);
+    assert!(err.contains("unknown preset `fast`; expected one of: preview, interactive, final, reference"), "{err}");
+}
+
+/// `quadray bench` on a tiny image: the report has a row per preset with
+/// finite, positive GPU times per pass and errors, and the plot, Markdown and
+/// images are written; a second run reuses the cached reference.
+#[test]
+fn bench_writes_its_report_and_caches_the_reference() {
+    let outdir = tempfile::tempdir().unwrap();
+    let dir = outdir.path();
+    let scene = write_scene(dir, "ball.toml", SPHERE_SCENE);
+    let out = dir.join("bench");
+    let args = [
+        "bench",
+        scene.to_str().unwrap(),
+        "--presets",
+        "preview,final",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--reference-spp",
+        "64",
+        "-o",
+        out.to_str().unwrap(),
+        "--validation",
+    ];
+    render_ok(&args, dir, &[]);
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("bench.json")).unwrap()).unwrap();
+    let rows = report["scenes"][0]["presets"].as_array().unwrap();
+    assert_eq!(rows.iter().map(|r| r["preset"].as_str().unwrap()).collect::<Vec<_>>(), ["preview", "final"]);
+    for r in rows {
+        for key in ["render_seconds", "gpu_seconds", "flip", "relative_mse"] {
+            let v = r[key].as_f64().unwrap();
+            assert!(v.is_finite() && v > 0.0, "{key} = {v} in {r}");
+        }
+    }
+    // More samples, less error against the reference.
+    assert!(rows[1]["flip"].as_f64() < rows[0]["flip"].as_f64(), "{rows:?}");
+    assert_eq!(report["scenes"][0]["reference"]["spp"], 64);
+    for f in ["bench.md", "bench.png", "ball-reference.png", "ball-preview.png", "ball-final.png"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let log = render_ok(&args, dir, &[]);
+    assert!(log.contains("using the cached reference"), "{log}");
+}
