@@ -95,7 +95,7 @@ void main() {
             if (abs(eta - 1.0) < 1e-6) {
                 // Index-matched: not an interface at all.
                 crossInterface(media, matIndex, entering);
-                o = offsetOrigin(p, h.normal, d);
+                o = offsetOrigin(p, h.normal, d, h.offset);
                 continue;
             }
             float etaRel = entering ? eta : 1.0 / eta;  // n_t / n_i
@@ -117,7 +117,7 @@ void main() {
         }
         path = extendPath(path, h.object * 4u + event);
         ++speculars;
-        o = offsetOrigin(p, h.normal, d);
+        o = offsetOrigin(p, h.normal, d, h.offset);
     }
     causticRays[e.firstRay + i] = ray;
 }

@@ -260,13 +260,42 @@ struct SceneHit {
     float gradientLength;  // |∇F'| in world units (0 on a miss)
     vec3 objectPoint;    // the hit in the object's frame
     mat3 worldToObject;  // linear part of the world-to-object transform
+    float offset;        // how far secondary rays start off the surface (world units)
 };
 
-// Offset along the geometric normal, to the side of `dir`, that keeps a
-// secondary ray off its own surface.
-vec3 offsetOrigin(vec3 p, vec3 n, vec3 dir) {
-    float scale = max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
-    return p + (dot(dir, n) >= 0.0 ? n : -n) * (2e-4 * scale);
+// How far along the normal a secondary ray must start from a hit at `p`
+// (world, camera-relative) to stay off its own surface: more than the hit
+// point's error along the normal, which has two parts (docs/stability.md,
+// "Secondary-ray offsets"):
+// - the f32 world position: a few ulps of its largest coordinate
+//   (OFFSET_WORLD = 1e-6 is about 8 ulps);
+// - the root found in the object frame: a small fraction of the cell's
+//   width along the normal, since the root's error along the ray is a
+//   fraction of the chord through the cell, whose component along the
+//   normal is at most that width (OFFSET_CELL = 1e-4).
+// A fixed 2e-4 · max(|p|, 1) before lost contact shadows of objects smaller
+// than ~1e-3 of their distance, or of objects smaller than 1e-3 units.
+const float OFFSET_WORLD = 1e-6;
+const float OFFSET_CELL = 1e-4;
+
+float hitOffset(vec3 p, uint cellIndex, vec3 objectNormal, mat3 worldToObject) {
+    Cell cell = cells[cellIndex];
+    vec3 extent = vec3(cell.hi[0], cell.hi[1], cell.hi[2]) - vec3(cell.lo[0], cell.lo[1], cell.lo[2]);
+    // The cell's width along the normal in the object frame (its diagonal
+    // where the gradient vanishes), in world units through the
+    // object-to-world map's largest stretch (an upper bound).
+    float g = length(objectNormal);
+    float width = g > 0.0 ? dot(abs(objectNormal / g), extent) : length(extent);
+    mat3 objectToWorld = inverse(worldToObject);
+    float stretch = max(max(length(objectToWorld[0]), length(objectToWorld[1])), length(objectToWorld[2]));
+    float far = max(max(abs(p.x), abs(p.y)), abs(p.z));
+    return OFFSET_WORLD * far + OFFSET_CELL * width * stretch;
+}
+
+// Offset along the geometric normal by `offset` (`SceneHit::offset`), to the
+// side of `dir`.
+vec3 offsetOrigin(vec3 p, vec3 n, vec3 dir, float offset) {
+    return p + (dot(dir, n) >= 0.0 ? n : -n) * offset;
 }
 
 // The object (instance custom index) and its cell (index into cells[]) of
@@ -336,6 +365,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
     h.gradientLength = 0.0;
     h.objectPoint = vec3(0.0);
     h.worldToObject = mat3(1.0);
+    h.offset = 0.0;
     if (rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionGeneratedEXT) {
         h.t = rayQueryGetIntersectionTEXT(rq, true);
         h.object = candidateObject(rq, true);
@@ -348,6 +378,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
         float len = length(n);
         h.normal = len > 0.0 ? n / len : -d;
         h.gradientLength = len;
+        h.offset = hitOffset(o + h.t * d, cell, g, h.worldToObject);
     }
     return h;
 }

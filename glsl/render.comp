@@ -236,7 +236,7 @@ uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
 // Next-event estimation at a vertex with a non-delta material: one light
 // chosen uniformly. `mis` is false at the last vertex, where no BSDF-sampled
 // continuation competes.
-vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, Medium med, bool mis, inout uint rng) {
+vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset, Medium med, bool mis, inout uint rng) {
     uint choices = lightChoices();
     if (choices == 0u) return vec3(0.0);
     uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
@@ -249,7 +249,7 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, Medium med, 
     // The shadow ray starts off the surface on the side of the light (either
     // side for a rough dielectric); the light's distance is shortened by the
     // part of the offset along the ray, so that the ray ends at the light.
-    vec3 origin = offsetOrigin(p, ng, ls.wi);
+    vec3 origin = offsetOrigin(p, ng, ls.wi, offset);
     float dist = ls.dist - dot(origin - p, ls.wi);
     if (!lightVisible(origin, ls.wi, dist, i)) return vec3(0.0);
     // The medium around the vertex attenuates the shadow ray (a shadow ray
@@ -472,7 +472,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             if (abs(mat.ior - 1.0) < 1e-6) {
                 // Invisible interface: continue straight on, into or out of this medium.
                 crossInterface(media, matIndex, entering);
-                o = offsetOrigin(o + h.t * d, h.normal, d);
+                o = offsetOrigin(o + h.t * d, h.normal, d, h.offset);
                 continue;
             }
         }
@@ -486,7 +486,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         bool primaryReceiver = CAUSTICS_ENABLED != 0u && bounce == 0u && mat.kind == MATERIAL_DIFFUSE
             && receivers[pixel].object == h.object;
         if (primaryReceiver) radiance += throughput * v3(mat.albedo) / PI * FIXED_POINT_RGB(causticMap, pixel);
-        if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, med, !last, rng);
+        if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, h.offset, med, !last, rng);
         if (last) break;
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
@@ -548,7 +548,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         scatterDensity = 0.0;
         lastPoint = p;
         d = normalize(frameW * bs.wi);
-        o = offsetOrigin(p, h.normal, d);
+        o = offsetOrigin(p, h.normal, d, h.offset);
 
         if (!survives(throughput, bounce, rng)) break;
         ++bounce;

@@ -530,7 +530,11 @@ fn presets_apply_and_single_flags_override_them() {
     );
     assert!(log.contains("(40x30, 3 spp,"), "{log}");
     // The file's own spp overrides the file's preset.
-    let log = render_ok(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--filter", "covariance"], dir, &[]);
+    let log = render_ok(
+        &["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--filter", "covariance"],
+        dir,
+        &[],
+    );
     assert!(log.contains("(40x30, 5 spp,"), "{log}");
     let err = render_fails(&["render", scene.to_str().unwrap(), "--preset", "fast"], dir);
     assert!(err.contains("unknown preset `fast`; expected one of: preview, interactive, final, reference"), "{err}");
@@ -561,7 +565,8 @@ fn bench_writes_its_report_and_caches_the_reference() {
         "--validation",
     ];
     render_ok(&args, dir, &[]);
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("bench.json")).unwrap()).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("bench.json")).unwrap()).unwrap();
     let rows = report["scenes"][0]["presets"].as_array().unwrap();
     assert_eq!(rows.iter().map(|r| r["preset"].as_str().unwrap()).collect::<Vec<_>>(), ["preview", "final"]);
     for r in rows {

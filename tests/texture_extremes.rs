@@ -1,0 +1,122 @@
+//! Texture sizes at the extremes, in every filtering mode: a 1x1 colour map
+//! and a 16384-texel-wide one (the largest side accepted,
+//! `MAX_TEXTURE_SIZE`) on a floor seen in perspective, from grazing to
+//! steep. For every pixel-centre hit the albedo AOV must be what the map
+//! holds at the hit's texture coordinates (from the CPU twin of the
+//! mapping):
+//!
+//! - the 1x1 map is one colour everywhere, whatever the footprint;
+//! - the 16k map is a linear ramp in u (texel i holds i / 16383), which
+//!   bilinear lookups reproduce exactly and which any footprint symmetric
+//!   about its centre averages to the value at the centre, at every mip level.
+//!
+//! The textures are f32 on the GPU, so the bounds measure addressing and
+//! filtering, not quantisation.
+
+mod common;
+
+use glam::{DAffine3, DVec2, DVec3, Vec3};
+use quadray::geometry::uv::object_uv;
+use quadray::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::passes::RenderVariant;
+use quadray::scene::{FilterMode, Material, MaterialMaps, Scene, UvMapping, UvSettings};
+use quadray::texture::{from_texels, MAX_TEXTURE_SIZE};
+
+const SIZE: (u32, u32) = (96, 64);
+
+/// A floor (y = 0, |x|, |z| ≤ 5) with u = 0.08 x + 0.5 (0.1 to 0.9 across
+/// it), v = 0.08 z + 0.5, seen from a low camera so that the footprints run
+/// from about a texel to grazing.
+fn floor_scene(texture: quadray::scene::TextureImage) -> Scene {
+    let floor = FunctionalObject {
+        base: Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
+        perturbations: vec![],
+        clip: Some(Aabb::new(DVec3::new(-5.0, -0.5, -5.0), DVec3::new(5.0, 0.5, 5.0))),
+    };
+    let mut object = common::object("floor", floor, DAffine3::IDENTITY);
+    object.uv = UvSettings {
+        mapping: UvMapping::Planar { u_axis: DVec3::X, v_axis: DVec3::Z },
+        scale: DVec2::splat(0.08),
+        offset: DVec2::splat(0.5),
+    };
+    let mut scene = common::scene_with(vec![object]);
+    let mut m = Material::diffuse("mapped", Vec3::ONE);
+    m.maps = MaterialMaps { albedo: Some(0), ..Default::default() };
+    scene.materials = vec![m];
+    scene.textures = vec![texture];
+    scene.camera.position = DVec3::new(0.0, 0.6, 5.5);
+    scene.camera.look_at = DVec3::new(0.0, 0.0, 0.0);
+    scene.camera.vfov_degrees = 50.0;
+    (scene.image.width, scene.image.height) = SIZE;
+    scene
+}
+
+/// Largest |albedo AOV − expected(uv)| over the floor's pixels, and how many
+/// were checked; `expected` may skip a pixel (None).
+fn worst_albedo_error(scene: &Scene, filter: FilterMode, expected: impl Fn(DVec2) -> Option<[f32; 3]>) -> (f64, usize) {
+    let variant = RenderVariant { filter: filter.constant(), ..Default::default() };
+    let out = common::render_variant_validated(scene, variant);
+    let (w, h) = SIZE;
+    let [eye, forward, right, up] = quadray::passes::scene_gpu::camera_basis(scene, w, h);
+    let (mut worst, mut checked) = (0.0f64, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let a = &out.aov[(y * w + x) as usize];
+            if !a.depth.is_finite() {
+                continue;
+            }
+            let nx = 2.0 * (x as f64 + 0.5) / w as f64 - 1.0;
+            let ny = 1.0 - 2.0 * (y as f64 + 0.5) / h as f64;
+            let p = eye + a.depth as f64 * (forward + nx * right + ny * up).normalize();
+            let (uv, _, _) = object_uv(&scene.objects[0].uv, p);
+            let Some(want) = expected(uv) else { continue };
+            checked += 1;
+            for (got, want) in a.albedo.iter().zip(want) {
+                worst = worst.max((*got as f64 - want as f64).abs());
+            }
+        }
+    }
+    (worst, checked)
+}
+
+#[test]
+fn a_one_texel_map_is_one_colour_at_every_footprint() {
+    const C: [f32; 3] = [0.8, 0.35, 0.05];
+    const BOUND: f64 = 1e-5;
+    let scene = floor_scene(from_texels("1x1".into(), 1, 1, vec![[C[0], C[1], C[2], 1.0]]));
+    for filter in FilterMode::ALL {
+        let (worst, checked) = worst_albedo_error(&scene, filter, |_| Some(C));
+        println!("1x1 map, filter {filter}: {checked} pixels, worst albedo error {worst:.2e} (bound {BOUND:.0e})");
+        assert!(checked > 2000);
+        assert!(worst <= BOUND, "{filter}: {worst}");
+    }
+}
+
+#[test]
+fn a_16k_wide_ramp_is_read_exactly_at_every_footprint() {
+    let width = MAX_TEXTURE_SIZE;
+    let ramp = |i: u32| i as f32 / (width - 1) as f32;
+    let texels: Vec<[f32; 4]> = (0..4).flat_map(|_| (0..width).map(|i| [ramp(i), 1.0 - ramp(i), 0.5, 1.0])).collect();
+    let scene = floor_scene(from_texels("16k ramp".into(), width, 4, texels));
+    assert_eq!(scene.textures[0].width, width, "no resampling of a power-of-two width");
+    // Bilinear between texel centres (i + 0.5) / width, clamped away from
+    // the wrap at u = 0 and 1 (not reached: u is in [0.1, 0.9]).
+    let expected = |uv: DVec2| {
+        let x = (uv.x * width as f64 - 0.5) / (width - 1) as f64;
+        (0.05..=0.95).contains(&uv.x).then_some([x as f32, (1.0 - x) as f32, 0.5])
+    };
+    // One texel of the ramp is 6.1e-5. Bounds: bilinear lookups within 0.16
+    // texel (f32 texture coordinates near u = 1 are good to about 2e-3
+    // texels); filtered lookups, whose footprints reach hundreds of texels at
+    // grazing angles and are truncated to a tap budget, centred within 16
+    // texels (0.1 % of the texture's width).
+    for (filter, bound) in [(FilterMode::None, 1e-5), (FilterMode::RayCones, 1e-3), (FilterMode::Covariance, 1e-3)] {
+        let (worst, checked) = worst_albedo_error(&scene, filter, expected);
+        println!(
+            "16384 x 4 ramp, filter {filter}: {checked} pixels, worst albedo error {worst:.2e} ({:.2} texels; bound {bound:.0e})",
+            worst * (width - 1) as f64
+        );
+        assert!(checked > 2000);
+        assert!(worst <= bound, "{filter}: {worst}");
+    }
+}
