@@ -6,6 +6,7 @@
 
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_EXT_ray_query : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "common.glsl"
 

@@ -108,6 +108,121 @@ vec3 perturbationAlongRay(uint k, vec3 p, vec3 d) {
     return quadricAlongRay(perturbations[k].q, p - v3(perturbations[k].centre), d);
 }
 
+// ---------------------------------------------------------------------------
+// f64 refinement. The f32 search works on F' expanded around each piece's
+// middle; where F' is tiny compared with its terms (a surface hugging a
+// perturbation's support boundary, where f·Q³ has a near-triple root, or
+// large form factors), f32 loses the sign of F' near the piece's ends and
+// the position of flat roots. There, F' is evaluated directly from the
+// quadrics in f64 (docs/stability.md, "Roots of multiplicity 2 and 3").
+// ---------------------------------------------------------------------------
+
+double quadricAt64(Quadric q, dvec3 p) {
+    return double(q.a[0]) * p.x * p.x + double(q.a[1]) * p.y * p.y + double(q.a[2]) * p.z * p.z
+         + 2.0 * (double(q.a[3]) * p.x * p.y + double(q.a[4]) * p.y * p.z + double(q.a[5]) * p.x * p.z)
+         + double(q.b[0]) * p.x + double(q.b[1]) * p.y + double(q.b[2]) * p.z + double(q.c);
+}
+
+// F' at the object-frame point p, with every perturbation the cell lists.
+double cellValue64(uint object, Cell cell, dvec3 p) {
+    double v = quadricAt64(objects[object].base, p);
+    [[dont_unroll]] for (uint i = 0; i < cell.count; ++i) {
+        uint k = cellLists[cell.first + i];
+        double q = quadricAt64(perturbations[k].q, p - dvec3(v3(perturbations[k].centre)));
+        if (q > 0.0) v += double(perturbations[k].f) * q * q * q;
+    }
+    return v;
+}
+
+// A root of F' along O + t D in [a, b], where fa = F'(a) and fb = F'(b)
+// have opposite signs: regula falsi with the Illinois modification.
+double bracketedRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double a, double b, double fa, double fb) {
+    int side = 0;
+    double c = a;
+    [[dont_unroll]] for (int it = 0; it < 60; ++it) {
+        c = (a * fb - b * fa) / (fb - fa);
+        if (!(c > a && c < b)) c = 0.5 * (a + b);
+        double fc = cellValue64(object, cell, O + c * D);
+        if (fc == 0.0 || b - a <= 1e-14 * max(abs(a), abs(b))) return c;
+        if ((fc < 0.0) == (fb < 0.0)) {
+            b = c;
+            fb = fc;
+            if (side == -1) fa *= 0.5;
+            side = -1;
+        } else {
+            a = c;
+            fa = fc;
+            if (side == 1) fb *= 0.5;
+            side = 1;
+        }
+    }
+    return c;
+}
+
+// True when the polynomial c at x is within `tolerance` of the size of its
+// terms there (1e-5: within a few f32 rounding errors, its sign unknown).
+bool nearlyCancels(float c[7], float x, float tolerance) {
+    float slope;
+    float v = evalPoly(c, x, slope);
+    float size = 0.0, xp = 1.0;
+    for (int j = 0; j < 7; ++j) {
+        size += abs(c[j]) * xp;
+        xp *= abs(x);
+    }
+    return abs(v) <= tolerance * size;
+}
+
+bool signUncertain(float c[7], float x) {
+    return nearlyCancels(c, x, 1e-5);
+}
+
+// The first root on the piece [ta, tb] of the ray O + t D (f64), given the
+// f32 search's root tr (NO_ROOT when it found none) on the polynomial c
+// expanded around tm: keeps tr where f64 confirms a sign change around it
+// and f32 is well conditioned there, else finds the root again in f64, or
+// drops it when f64 sees no sign change (see above). Returns a ray
+// parameter, or -1 for none.
+double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double tb, double tm, float c[7], float tr) {
+    bool startUncertain = signUncertain(c, float(ta - tm));
+    double t = tm + double(tr);
+    float step = 1e-3 * float(tb - ta);
+    bool found = tr != NO_ROOT;
+    if (found) {
+        // A root where F' stays far from its terms' size a little way off
+        // is well conditioned in f32 and kept as it is.
+        if (!startUncertain && !nearlyCancels(c, tr + step, 1e-2) && !nearlyCancels(c, tr - step, 1e-2)) return t;
+    } else if (!startUncertain && !signUncertain(c, float(tb - tm))) {
+        return -1.0;
+    }
+    bool flatRoot = found && (signUncertain(c, tr + step) || signUncertain(c, tr - step));
+    // F' in f64 at the piece's start, around the f32 root, and at its end.
+    // (One evaluation site and one solver site below: the shader compiler
+    // inlines all of this into every intersection call.)
+    double w = 1e-3 * (tb - ta) + 1e-7 * abs(t);
+    double at[4] = double[4](ta, found ? max(ta, t - w) : ta, found ? min(tb, t + w) : ta, tb);
+    double v[4];
+    [[dont_unroll]] for (int i = 0; i < 4; ++i) v[i] = cellValue64(object, cell, O + at[i] * D);
+    // The bracket: an earlier root near an uncertain start, then the f32
+    // root confirmed by a sign change around it, then anywhere in the piece
+    // (f32 placed the root badly or found none); no sign change in f64: no
+    // root (f32 made it up).
+    int lo = -1, hi = -1;
+    if (found && startUncertain && (v[0] < 0.0) != (v[1] < 0.0)) {
+        lo = 0;
+        hi = 1;
+    } else if (found && (v[1] < 0.0) != (v[2] < 0.0)) {
+        if (!flatRoot) return t;
+        lo = 1;
+        hi = 2;
+    } else if ((v[0] < 0.0) != (v[3] < 0.0)) {
+        lo = 0;
+        hi = 3;
+    }
+    if (lo < 0) return -1.0;
+    if (v[lo] == 0.0) return at[lo];
+    return bracketedRoot64(object, cell, O, D, at[lo], at[hi], v[lo], v[hi]);
+}
+
 // First t in [tlo, thi] (and inside the cell) where F' = 0 along o + t d, in
 // the object's frame; NO_ROOT if none.
 // The ray is (o, d); when `rebased`, (o64, d64) is the same ray in f64
@@ -202,7 +317,16 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
                 }
             }
             float r = any ? firstRoot(c, sa - sm, sb - sm) : quadraticFirstRoot(b, sa - sm, sb - sm);
-            if (r != NO_ROOT) {
+            if (any) {
+                // Ray parameters in f64: the ray is O + t D with t = tc + s.
+                dvec3 O = rebased ? o64 : dvec3(o), D = rebased ? d64 : dvec3(d);
+                double t64 = refineRoot64(object, cell, O, D, double(tc) + double(sa), double(tc) + double(sb),
+                                          double(tc) + double(sm), c, r);
+                if (t64 >= 0.0) {
+                    hitPoint = vec3(O + t64 * D);
+                    return float(t64);
+                }
+            } else if (r != NO_ROOT) {
                 hitPoint = p + (sm + r) * d;
                 return tc + sm + r;
             }

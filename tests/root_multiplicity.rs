@@ -53,7 +53,12 @@ fn trace(shape: FunctionalObject, probes: &[Probe]) -> Vec<quadray::passes::gpu:
 }
 
 /// Prints the table and returns the probes that break the bound.
-fn report(name: &str, probes: &[Probe], hits: &[quadray::passes::gpu::GpuHit], gap: impl Fn(f64) -> f64) -> Vec<String> {
+fn report(
+    name: &str,
+    probes: &[Probe],
+    hits: &[quadray::passes::gpu::GpuHit],
+    gap: impl Fn(f64) -> f64,
+) -> Vec<String> {
     println!("{name}:");
     println!("| δ | exact t | GPU t | error | bound | gap to the next root |");
     println!("|---:|---:|---:|---:|---:|---:|");
@@ -122,7 +127,9 @@ fn double_and_near_triple_roots_against_their_closed_forms() {
     let hits = trace(cubic, &probes);
     // The other two roots of x³ = δ are complex, |x| apart from the real one
     // times √3.
-    bad.extend(report("cubic dent, y = −δ (near-triple root as δ → 0)", &probes, &hits, |d| 3f64.sqrt() * d.cbrt()));
+    bad.extend(report("cubic dent, y = −δ (near-triple root as δ → 0)", &probes, &hits, |d| {
+        3f64.sqrt() * d.cbrt()
+    }));
 
     assert!(bad.is_empty(), "outside the conditioning bound: {bad:?}");
 }

@@ -12,6 +12,10 @@
 //! renders do, centred on the camera): the GPU's frame is centred on the
 //! rays' start region in f64 (`GpuScene::with_origin`), so ε = 6e-8 · 6 s / s
 //! everywhere and every case is held to the bounds.
+//!
+//! `QUADRAY_DEBUG_FAILURES=1` prints every failure with the first sign
+//! change of F' that dense f64 sampling of the ray finds (an arbiter where
+//! the GPU and the reference disagree).
 
 mod common;
 
@@ -106,7 +110,30 @@ fn measure(
                 a.max_normal = a.max_normal.max(gn.dot(n).clamp(-1.0, 1.0).acos().to_degrees());
             }
             _ if near_edge => a.excused += 1,
-            _ => a.failures += 1,
+            (r, _) => {
+                if std::env::var_os("QUADRAY_DEBUG_FAILURES").is_some() {
+                    // The first sign change of F' by dense f64 sampling.
+                    let n = 400_000;
+                    let mut first = None;
+                    let mut prev = shape.eval(ol);
+                    for i in 1..=n {
+                        let t = 12.0 * i as f64 / n as f64;
+                        let v = shape.eval(ol + t * dl);
+                        if (v >= 0.0) != (prev >= 0.0) {
+                            first = Some(t);
+                            break;
+                        }
+                        prev = v;
+                    }
+                    eprintln!(
+                        "failure: reference {:?}, GPU t {} object {}, dense sampling {first:?}",
+                        r.map(|x| x.0),
+                        g.t,
+                        g.object
+                    );
+                }
+                a.failures += 1
+            }
         }
     }
     a
@@ -210,8 +237,10 @@ fn extremes() -> Vec<Extreme> {
             shape: sphere(common::spread_bumps(12, 1.0, 0.4, f, true)),
             aim: 1.2,
             // Beyond f ~ 1e2 the surface hugs the bumps' support boundary,
-            // where f Q³ has a near-triple root: the f32 search degrades.
-            holds: f <= 1.0,
+            // where f Q³ has a near-triple root; the f32 search alone
+            // degraded there, the f64 refinement of uncertain roots holds
+            // to 1e3 (not yet at 1e6).
+            holds: f <= 1e3,
             max_failures: 0.0,
             max_depth: 1e-4,
             max_normal: 0.5,
