@@ -283,13 +283,30 @@ fn extremes() -> Vec<Extreme> {
         max_depth: 1e-4,
         max_normal: 0.5,
     });
+    // Near-planar quadrics: the paraboloid y = ε (x² + z²), clipped to the
+    // unit box, whose curvature vanishes next to its linear term.
+    for eps in [1e-3, 1e-7] {
+        out.push(Extreme {
+            name: format!("near-planar {eps:.0e}"),
+            shape: FunctionalObject {
+                base: Quadric::from_coefficients([eps, 0.0, eps, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
+                perturbations: vec![],
+                clip: Some(quadray::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
+            },
+            aim: 0.9,
+            holds: true,
+            max_failures: 0.0,
+            max_depth: 1e-4,
+            max_normal: 0.5,
+        });
+    }
     out
 }
 
 /// Shapes at the extremes against the f64 reference: perturbation form
 /// factors from 1e-6 to 1e6 of the base's, hundreds of overlapping
 /// perturbations, nearly degenerate quadrics (thin and needle ellipsoids, a
-/// cone's apex). Each case states its bounds; the table prints the measured
+/// cone's apex, near-planar paraboloids). Each case states its bounds; the table prints the measured
 /// figures.
 #[test]
 fn shapes_at_the_extremes_against_the_f64_reference() {
