@@ -92,16 +92,16 @@ pub struct CausticMap {
 /// One grid per light and light sample, each aimed at the bounds of all the
 /// specular objects (one grid, so that no ray is counted twice where specular
 /// objects nest, like water in a glass vessel). Positions are relative to
-/// `origin` (the GPU frame's), computed in f64. `None` when a light sits inside those bounds
+/// `origin` (the GPU frame's), computed in f64; each grid has about `rays`
+/// rays. `None` when a light sits inside those bounds
 /// (no grid plane in front of it can see them all).
-pub fn emitters(scene: &Scene, origin: DVec3, max_specular: u32) -> Option<Vec<GpuEmitter>> {
+pub fn emitters(scene: &Scene, origin: DVec3, max_specular: u32, rays: u32) -> Option<Vec<GpuEmitter>> {
     let corners: Vec<DVec3> = specular_corners(scene).into_iter().map(|c| c - origin).collect();
     if corners.is_empty() {
         return Some(Vec::new());
     }
     let centre_rel = corners.iter().fold(DVec3::ZERO, |a, &c| a + c) / corners.len() as f64;
     let radius = corners.iter().map(|c| c.distance(centre_rel)).fold(0.0, f64::max);
-    let rays = scene.caustics.rays;
     let mut out = Vec::new();
     for light in scene.lights.iter().filter(|l| l.emits_caustic_rays()) {
         match *light {

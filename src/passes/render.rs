@@ -441,7 +441,7 @@ fn caustic_map(
     }
     // A caustic path from the camera: the receiver (a bounce), the specular
     // vertices (a bounce each), then the light found by the next segment.
-    let Some(mut grids) = emitters(scene, gpu.origin, max_depth - 2) else {
+    let Some(mut grids) = emitters(scene, gpu.origin, max_depth - 2, scene.caustics.rays) else {
         log::warn!("a light is inside the bounds of the specular objects: caustics are left to the path tracer");
         return Ok(None);
     };
@@ -452,15 +452,14 @@ fn caustic_map(
     let total = |g: &[GpuEmitter]| g.iter().map(|e| e.grid[0] as u64 * e.grid[1] as u64).sum::<u64>();
     if total(&grids) > fits {
         let asked = total(&grids);
-        let mut fewer = scene.clone();
         let scale = fits as f64 / asked as f64;
-        fewer.caustics.rays = ((scene.caustics.rays as f64 * scale * 0.95) as u32).max(1);
-        grids = emitters(&fewer, gpu.origin, max_depth - 2).unwrap_or_default();
+        let fewer = ((scene.caustics.rays as f64 * scale * 0.95) as u32).max(1);
+        grids = emitters(scene, gpu.origin, max_depth - 2, fewer).unwrap_or_default();
         log::warn!(
             "{asked} caustic rays do not fit in one storage buffer of this device ({fits} rays); tracing {} \
              ({} per light and light sample)",
             total(&grids),
-            fewer.caustics.rays
+            fewer
         );
     }
     Ok(Some(CausticMap::new(device, gpu, scene, frame, size, &grids)?))
