@@ -195,32 +195,32 @@ double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double 
         return -1.0;
     }
     bool flatRoot = found && (signUncertain(c, tr + step) || signUncertain(c, tr - step));
-    // F' in f64 at the piece's start, around the f32 root, and at its end.
-    // (One evaluation site and one solver site below: the shader compiler
-    // inlines all of this into every intersection call.)
+    // F' in f64 at the piece's start, its middle, either side of the f32
+    // root (if any), and its end, in order along the ray. (One evaluation
+    // site and one solver site below: the shader compiler inlines all of
+    // this into every intersection call.)
     double w = 1e-3 * (tb - ta) + 1e-7 * abs(t);
-    double at[4] = double[4](ta, found ? max(ta, t - w) : ta, found ? min(tb, t + w) : ta, tb);
-    double v[4];
-    [[dont_unroll]] for (int i = 0; i < 4; ++i) v[i] = cellValue64(object, cell, O + at[i] * D);
-    // The bracket: an earlier root near an uncertain start, then the f32
-    // root confirmed by a sign change around it, then anywhere in the piece
-    // (f32 placed the root badly or found none); no sign change in f64: no
-    // root (f32 made it up).
-    int lo = -1, hi = -1;
-    if (found && startUncertain && (v[0] < 0.0) != (v[1] < 0.0)) {
-        lo = 0;
-        hi = 1;
-    } else if (found && (v[1] < 0.0) != (v[2] < 0.0)) {
-        if (!flatRoot) return t;
-        lo = 1;
-        hi = 2;
-    } else if ((v[0] < 0.0) != (v[3] < 0.0)) {
-        lo = 0;
-        hi = 3;
+    double rootLo = found ? max(ta, t - w) : tm, rootHi = found ? min(tb, t + w) : tm;
+    double at[5] = double[5](ta, min(rootLo, tm), clamp(tm, rootLo, rootHi), max(rootHi, tm), tb);
+    double v[5];
+    [[dont_unroll]] for (int i = 0; i < 5; ++i) v[i] = cellValue64(object, cell, O + at[i] * D);
+    // The root is in the first interval whose ends differ in sign in f64:
+    // the f32 root itself when that interval is the one around it and f32
+    // is well conditioned there, else found again in f64. Looking at the
+    // middle too catches pairs of roots that f32 cannot see and the ends
+    // cannot tell apart: a ray through a wall-like bump at a large form
+    // factor enters and leaves its support within one piece, each root
+    // a hair inside it, where f32 has lost F' to rounding (and may report a
+    // spurious root at the piece's start instead). No sign change in f64:
+    // no root (f32 made it up).
+    int lo = -1;
+    [[dont_unroll]] for (int i = 0; i < 4 && lo < 0; ++i) {
+        if ((v[i] < 0.0) != (v[i + 1] < 0.0)) lo = i;
     }
     if (lo < 0) return -1.0;
+    if (found && !flatRoot && at[lo] <= t && t <= at[lo + 1] && at[lo + 1] - at[lo] <= 2.0 * w) return t;
     if (v[lo] == 0.0) return at[lo];
-    return bracketedRoot64(object, cell, O, D, at[lo], at[hi], v[lo], v[hi]);
+    return bracketedRoot64(object, cell, O, D, at[lo], at[lo + 1], v[lo], v[lo + 1]);
 }
 
 // First t in [tlo, thi] (and inside the cell) where F' = 0 along o + t d, in

@@ -35,6 +35,10 @@ pub enum RenderError {
     /// The scene uses more texture maps than the shader's texture array holds.
     #[error("the scene uses {0} texture maps; at most {max} are supported", max = shader_interface::MAX_TEXTURES - 1)]
     TooManyTextures(usize),
+    /// A texture map is too large for the device in every encoding that
+    /// holds its values.
+    #[error(transparent)]
+    TextureTooLarge(#[from] texture::encoding::TextureTooLarge),
     /// An object cannot be rendered.
     #[error("object `{object}`: {source}")]
     Geometry {

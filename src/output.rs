@@ -81,21 +81,12 @@ pub fn write_outputs(out: &RenderOutput, files: &[(PathBuf, OutputKind)]) -> io:
     })
 }
 
-/// sRGB transfer function of a linear value in [0, 1].
-fn srgb_encode(v: f32) -> f32 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// 8-bit sRGB pixels: radiance · 2^exposure, clamped to [0, 1], encoded.
 pub fn tone_map(out: &RenderOutput, exposure: f32) -> Vec<u8> {
     let scale = exposure.exp2();
     out.radiance
         .iter()
-        .flat_map(|p| p.map(|v| (srgb_encode((v * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
+        .flat_map(|p| p.map(|v| (crate::texture::linear_to_srgb((v * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
         .collect()
 }
 

@@ -50,7 +50,7 @@ struct Agreement {
     max_normal: f64,
 }
 
-/// Traces `RAYS` rays from 6 `s` away from `centre` toward random points of
+/// Traces `rays` rays from 6 `s` away from `centre` toward random points of
 /// the box `target_radius` · s around it, on the GPU (frame origin `origin`)
 /// and in f64 on the same f32 rays.
 #[allow(clippy::too_many_arguments)]
@@ -63,6 +63,7 @@ fn measure(
     origin: DVec3,
     s: f64,
     target_radius: f64,
+    rays: usize,
 ) -> Agreement {
     let bounds = shape.bounds().unwrap();
     let centre = transform.translation;
@@ -70,7 +71,7 @@ fn measure(
     let object = quadray::scene::SceneObject { transform, ..common::object("shape", shape.clone(), transform) };
     let scene = common::scene_with(vec![object]);
     let gpu = GpuScene::with_origin(&ctx.device, cmds, &scene, &CellParams::default(), origin).unwrap();
-    let rays: Vec<GpuRay> = (0..RAYS)
+    let rays: Vec<GpuRay> = (0..rays)
         .map(|_| {
             let o = centre + 6.0 * s * common::random_unit(rng);
             let jitter = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 2.0 - 1.0;
@@ -96,7 +97,11 @@ fn measure(
             (h.t, n)
         });
         let gn = DVec3::from_array(g.normal.map(f64::from));
-        let near_edge = r.is_some_and(|(_, n)| n.dot(d).abs() < sil) || (g.object != NO_HIT && gn.dot(d).abs() < sil);
+        // Hits at the rim of a clip box are excused too: the GPU's boxes are
+        // the f64 ones rounded outward to f32.
+        let on_rim = |t: f64| shape.clip.as_ref().is_some_and(|b| on_box_rim(b, ol + t * dl));
+        let near_edge = r.is_some_and(|(t, n)| n.dot(d).abs() < sil || on_rim(t))
+            || (g.object != NO_HIT && (gn.dot(d).abs() < sil || on_rim(g.t as f64)));
         match (r, g.object != NO_HIT) {
             (None, false) => a.agree += 1,
             (Some((t, n)), true) if ((g.t as f64) - t).abs() < 0.05 * t => {
@@ -126,7 +131,7 @@ fn measure(
                         prev = v;
                     }
                     eprintln!(
-                        "failure: reference {:?}, GPU t {} object {}, dense sampling {first:?}",
+                        "failure: reference {:?}, GPU t {} object {}, dense sampling {first:?}, object-frame ray {ol} + t {dl}",
                         r.map(|x| x.0),
                         g.t,
                         g.object
@@ -175,7 +180,7 @@ fn scales_and_offsets_against_the_f64_reference() {
                     centre,
                 );
                 let origin = if relative { centre + DVec3::new(0.0, 0.0, 6.0 * s) } else { DVec3::ZERO };
-                let a = measure(&ctx, &mut cmds, &mut rng, &shape, transform, origin, s, 0.65);
+                let a = measure(&ctx, &mut cmds, &mut rng, &shape, transform, origin, s, 0.65, RAYS);
                 let epsilon = 6e-8 * ((centre - origin).length() + 6.0 * s) / s;
                 let bounded = epsilon <= TRUSTED_EPSILON;
                 let frame = if relative { "relative" } else { "world" };
@@ -206,17 +211,23 @@ fn scales_and_offsets_against_the_f64_reference() {
     assert!(violations.is_empty(), "beyond the bounds: {violations:?}");
 }
 
+/// Whether `p` lies within 1e-5 of the box's size of one of its faces.
+fn on_box_rim(b: &quadray::geometry::Aabb, p: DVec3) -> bool {
+    let tol = 1e-5 * (b.max - b.min).max_element();
+    let inside = p.cmpge(b.min - tol).all() && p.cmple(b.max + tol).all();
+    let near_face = (p - b.min).abs().min_element() <= tol || (b.max - p).abs().min_element() <= tol;
+    inside && near_face
+}
+
 /// One extreme shape of [`shapes_at_the_extremes_against_the_f64_reference`]:
-/// its name, the shape, how far from its centre the rays aim, whether the
-/// bounds are expected to hold (`false`: a known degradation, printed and
-/// checked only for NaN/Inf; docs/stability.md), and its bounds on
-/// unexcused disagreements (as a fraction of the rays), relative depth
-/// error and normal error (degrees).
+/// its name, the shape, how many rays and how far from its centre they aim,
+/// and its bounds on unexcused disagreements (as a fraction of the rays),
+/// relative depth error and normal error (degrees).
 struct Extreme {
     name: String,
     shape: FunctionalObject,
+    rays: usize,
     aim: f64,
-    holds: bool,
     max_failures: f64,
     max_depth: f64,
     max_normal: f64,
@@ -230,27 +241,33 @@ fn extremes() -> Vec<Extreme> {
     };
     let mut out = Vec::new();
     // Form factors of 12 alternating bumps and dents (radius 0.4) relative to
-    // the unit sphere's, from invisible to walls at the supports' edges.
-    for f in [1e-6, 1e-3, 1.0, 1e3, 1e6] {
+    // the unit sphere's, from invisible to walls at the supports' edges,
+    // 20,000 rays each (`STRESS_FORM_FACTOR_RAYS` sets another count).
+    // Beyond f ~ 1e2 the surface hugs the bumps' support boundaries, where
+    // f Q³ has a near-triple root and f32 loses F' to rounding near a
+    // piece's ends; the f64 refinement (`refineRoot64`) settles those
+    // pieces, but from 1e3 on a pair of roots that both lie where f32 cannot
+    // tell F' from 0 is still missed now and then: over 200,000 rays each,
+    // 5, 6, 3, 2 and 1 wrong rays at 1e3 … 1e7 (at most 3e-5 of the rays),
+    // held here to 1e-4. The walls' normals, from f32 gradients 1e6 times
+    // the base's, err by up to 0.58° at 1e6 and 1.85° at 1e7 over those
+    // rays (0.26° at 1e5), held to 3°.
+    for f in [1e-6, 1e-3, 1.0, 1e3, 1e4, 1e5, 1e6, 1e7] {
         out.push(Extreme {
             name: format!("form factor {f:.0e}"),
             shape: sphere(common::spread_bumps(12, 1.0, 0.4, f, true)),
+            rays: std::env::var("STRESS_FORM_FACTOR_RAYS").map_or(20_000, |v| v.parse().expect("a ray count")),
             aim: 1.2,
-            // Beyond f ~ 1e2 the surface hugs the bumps' support boundary,
-            // where f Q³ has a near-triple root; the f32 search alone
-            // degraded there, the f64 refinement of uncertain roots holds
-            // to 1e3 (not yet at 1e6).
-            holds: f <= 1e3,
-            max_failures: 0.0,
+            max_failures: if f <= 1.0 { 0.0 } else { 1e-4 },
             max_depth: 1e-4,
-            max_normal: 0.5,
+            max_normal: if f <= 1e5 { 0.5 } else { 3.0 },
         });
     }
     out.push(Extreme {
         name: "300 overlapping bumps".into(),
         shape: sphere(common::spread_bumps(300, 1.0, 0.5, 0.05, true)),
+        rays: RAYS,
         aim: 1.0,
-        holds: true,
         max_failures: 0.0,
         max_depth: 1e-4,
         max_normal: 0.5,
@@ -261,8 +278,8 @@ fn extremes() -> Vec<Extreme> {
         out.push(Extreme {
             name: name.into(),
             shape: FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, radii), perturbations: vec![], clip: None },
+            rays: RAYS,
             aim: 0.8,
-            holds: true,
             max_failures: 0.0,
             max_depth: 1e-4,
             max_normal: 0.5,
@@ -277,8 +294,8 @@ fn extremes() -> Vec<Extreme> {
             perturbations: vec![],
             clip: Some(quadray::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
         },
+        rays: RAYS,
         aim: 0.05,
-        holds: true,
         max_failures: 0.0,
         max_depth: 1e-4,
         max_normal: 0.5,
@@ -293,8 +310,8 @@ fn extremes() -> Vec<Extreme> {
                 perturbations: vec![],
                 clip: Some(quadray::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
             },
+            rays: RAYS,
             aim: 0.9,
-            holds: true,
             max_failures: 0.0,
             max_depth: 1e-4,
             max_normal: 0.5,
@@ -304,7 +321,7 @@ fn extremes() -> Vec<Extreme> {
 }
 
 /// Shapes at the extremes against the f64 reference: perturbation form
-/// factors from 1e-6 to 1e6 of the base's, hundreds of overlapping
+/// factors from 1e-6 to 1e7 of the base's, hundreds of overlapping
 /// perturbations, nearly degenerate quadrics (thin and needle ellipsoids, a
 /// cone's apex, near-planar paraboloids). Each case states its bounds; the table prints the measured
 /// figures.
@@ -321,9 +338,10 @@ fn shapes_at_the_extremes_against_the_f64_reference() {
     let mut violations = Vec::new();
     for e in extremes() {
         let transform = DAffine3::from_rotation_y(0.7);
-        let a = measure(&ctx, &mut cmds, &mut rng, &e.shape, transform, DVec3::new(0.0, 0.0, 6.0), 1.0, e.aim);
+        let origin = DVec3::new(0.0, 0.0, 6.0);
+        let a = measure(&ctx, &mut cmds, &mut rng, &e.shape, transform, origin, 1.0, e.aim, e.rays);
         println!(
-            "{:>22} {:>6} {:>6} {:>8} {:>8} {:>11.2e} {:>11.4}   {}",
+            "{:>22} {:>6} {:>6} {:>8} {:>8} {:>11.2e} {:>11.4}   bounds: failures {} of {}, depth {:.0e}, normal {}°",
             e.name,
             a.hits,
             a.agree,
@@ -331,21 +349,15 @@ fn shapes_at_the_extremes_against_the_f64_reference() {
             a.failures,
             a.max_depth,
             a.max_normal,
-            if e.holds {
-                format!(
-                    "bounds: failures {:.0}%, depth {:.0e}, normal {}°",
-                    100.0 * e.max_failures,
-                    e.max_depth,
-                    e.max_normal
-                )
-            } else {
-                "degrades (known; finite values only)".to_string()
-            }
+            (e.max_failures * e.rays as f64).round(),
+            e.rays,
+            e.max_depth,
+            e.max_normal
         );
-        let within = a.failures as f64 <= e.max_failures * RAYS as f64
+        let within = a.failures as f64 <= e.max_failures * e.rays as f64
             && a.max_depth <= e.max_depth
             && a.max_normal <= e.max_normal;
-        if e.holds && !within {
+        if !within {
             violations.push(e.name);
         }
     }

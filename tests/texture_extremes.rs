@@ -10,8 +10,11 @@
 //!   bilinear lookups reproduce exactly and which any footprint symmetric
 //!   about its centre averages to the value at the centre, at every mip level.
 //!
-//! The textures are f32 on the GPU, so the bounds measure addressing and
-//! filtering, not quantisation.
+//! These two maps are f32 on the GPU, so their bounds measure addressing
+//! and filtering, not quantisation. A third, 16384 x 16384 map (5.3 GiB of
+//! f32 with its mips, more than lavapipe's largest allocation of 2 GiB) is
+//! stored in 8-bit sRGB (`texture::encoding`) and must still be read at
+//! full resolution: a checker of single texels in its blue channel.
 
 mod common;
 
@@ -20,6 +23,7 @@ use quadray::geometry::uv::object_uv;
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};
 use quadray::passes::RenderVariant;
 use quadray::scene::{FilterMode, Material, MaterialMaps, Scene, UvMapping, UvSettings};
+use quadray::texture::encoding::TexelEncoding;
 use quadray::texture::{from_texels, MAX_TEXTURE_SIZE};
 
 const SIZE: (u32, u32) = (96, 64);
@@ -54,11 +58,21 @@ fn floor_scene(texture: quadray::scene::TextureImage) -> Scene {
 /// Largest |albedo AOV − expected(uv)| over the floor's pixels, and how many
 /// were checked; `expected` may skip a pixel (None).
 fn worst_albedo_error(scene: &Scene, filter: FilterMode, expected: impl Fn(DVec2) -> Option<[f32; 3]>) -> (f64, usize) {
+    let (worst, checked) = worst_albedo_errors(scene, filter, expected);
+    (worst.into_iter().fold(0.0, f64::max), checked)
+}
+
+/// [`worst_albedo_error`] per channel.
+fn worst_albedo_errors(
+    scene: &Scene,
+    filter: FilterMode,
+    expected: impl Fn(DVec2) -> Option<[f32; 3]>,
+) -> ([f64; 3], usize) {
     let variant = RenderVariant { filter: filter.constant(), ..Default::default() };
     let out = common::render_variant_validated(scene, variant);
     let (w, h) = SIZE;
     let [eye, forward, right, up] = quadray::passes::scene_gpu::camera_basis(scene, w, h);
-    let (mut worst, mut checked) = (0.0f64, 0);
+    let (mut worst, mut checked) = ([0.0f64; 3], 0);
     for y in 0..h {
         for x in 0..w {
             let a = &out.aov[(y * w + x) as usize];
@@ -71,8 +85,8 @@ fn worst_albedo_error(scene: &Scene, filter: FilterMode, expected: impl Fn(DVec2
             let (uv, _, _) = object_uv(&scene.objects[0].uv, p);
             let Some(want) = expected(uv) else { continue };
             checked += 1;
-            for (got, want) in a.albedo.iter().zip(want) {
-                worst = worst.max((*got as f64 - want as f64).abs());
+            for (c, (got, want)) in a.albedo.iter().zip(want).enumerate() {
+                worst[c] = worst[c].max((*got as f64 - want as f64).abs());
             }
         }
     }
@@ -118,5 +132,75 @@ fn a_16k_wide_ramp_is_read_exactly_at_every_footprint() {
         );
         assert!(checked > 2000);
         assert!(worst <= bound, "{filter}: {worst}");
+    }
+}
+
+#[test]
+fn a_16k_square_map_is_stored_in_8_bits_and_read_at_full_resolution() {
+    let size = MAX_TEXTURE_SIZE;
+    let ramp = |i: u32| i as f32 / (size - 1) as f32;
+    let texel = |i: u32, j: u32| [ramp(i), ramp(j), ((i + j) % 2) as f32, 1.0];
+    let texels: Vec<[f32; 4]> = (0..size).flat_map(|j| (0..size).map(move |i| texel(i, j))).collect();
+    let scene = floor_scene(from_texels("16k x 16k".into(), size, size, texels));
+    assert_eq!((scene.textures[0].width, scene.textures[0].height), (size, size));
+
+    // Filter `none`: bilinear lookups of level 0 of what was stored, the
+    // texels decoded from 8-bit sRGB (exact for the checker's 0 and 1).
+    let stored = |i: u32, j: u32| TexelEncoding::Srgb8.round_trip(texel(i % size, j % size));
+    let bilinear = |uv: DVec2| {
+        let (x, y) = (uv.x * size as f64 - 0.5, uv.y * size as f64 - 0.5);
+        let (i, j) = (x.floor(), y.floor());
+        let (fx, fy) = (x - i, y - j);
+        let (i, j) = (i as u32, j as u32);
+        let [a, b, c, d] = [stored(i, j), stored(i + 1, j), stored(i, j + 1), stored(i + 1, j + 1)];
+        let texel = std::array::from_fn(|k| {
+            let top = a[k] as f64 * (1.0 - fx) + b[k] as f64 * fx;
+            let bottom = c[k] as f64 * (1.0 - fx) + d[k] as f64 * fx;
+            (top * (1.0 - fy) + bottom * fy) as f32
+        });
+        Some(texel)
+    };
+    let (worst, checked) = worst_albedo_errors(&scene, FilterMode::None, bilinear);
+    println!(
+        "16384 x 16384 map in 8-bit sRGB, filter none: {checked} pixels, worst error of the ramps {:.2e} and {:.2e}, \
+         of the single-texel checker {:.2e} (bounds {RAMP:.1e}, {CHECKER:.0e})",
+        worst[0], worst[1], worst[2]
+    );
+    // Bounds. The checker changes by up to 1 a texel, so its error is the
+    // addressing error in texels plus the precision of the GPU's bilinear
+    // weights (8 bits on many GPUs: 4e-3): it shows the map is read at full
+    // resolution. Its 0 and 1 decode exactly; the ramps' codes do not, and
+    // Vulkan leaves the precision of sRGB decoding loose: the ramps (6.1e-5
+    // a texel, so addressing is no part of their error) are held to half an
+    // 8-bit sRGB step, 2.2e-3 (lavapipe's decoding errs by about 1.2e-3).
+    const RAMP: f64 = 2.2e-3;
+    const CHECKER: f64 = 1e-2;
+    assert!(checked > 2000);
+    assert!(worst[0] <= RAMP && worst[1] <= RAMP && worst[2] <= CHECKER, "{worst:?}");
+
+    // Filtered lookups: footprints symmetric about their centre average the
+    // ramps to their value there, within the sRGB8 rounding of the stored
+    // ramps and its decoding (half a step each: 4.5e-3 together) and the
+    // 16-texel centring bound of the ramp test above (1e-3). The map
+    // repeats, so a footprint reaching across its edge averages in the far
+    // side of the ramp: the floor's far edge (v = 0.10 to 0.11, the last row
+    // of pixels, whose footprints span a tenth of the map along v and read
+    // mips of a few texels, blended across the edge at v = 0) reads up to
+    // 0.05 too high. Pixels with v < 0.15 are left out.
+    let centre = |uv: DVec2| {
+        let x = (uv.x * size as f64 - 0.5) / (size - 1) as f64;
+        let y = (uv.y * size as f64 - 0.5) / (size - 1) as f64;
+        ((0.05..=0.95).contains(&uv.x) && (0.15..=0.95).contains(&uv.y)).then_some([x as f32, y as f32, 0.5])
+    };
+    const BOUND: f64 = 4.5e-3 + 1e-3;
+    for filter in [FilterMode::RayCones, FilterMode::Covariance] {
+        let (worst, checked) = worst_albedo_errors(&scene, filter, centre);
+        println!(
+            "16384 x 16384 map in 8-bit sRGB, filter {filter}: {checked} pixels, worst error of the ramps {:.2e} and \
+             {:.2e} (bound {BOUND:.1e})",
+            worst[0], worst[1]
+        );
+        assert!(checked > 2000);
+        assert!(worst[0] <= BOUND && worst[1] <= BOUND, "{filter}: {worst:?}");
     }
 }

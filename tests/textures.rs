@@ -369,3 +369,19 @@ fn from_texels_resamples_and_builds_mips() {
     assert_eq!((t.source.as_str(), t.width, t.height, t.levels.len()), ("test", 4, 4, 3));
     assert!(t.levels.iter().flatten().all(|p| *p == [0.5; 4]));
 }
+
+#[test]
+fn exr_texels_must_be_finite() {
+    let dir = Dir::new();
+    for (name, bad) in [("nan.exr", f32::NAN), ("inf.exr", f32::INFINITY), ("neginf.exr", f32::NEG_INFINITY)] {
+        let path = dir.path(name);
+        exr::prelude::write_rgba_file(&path, 4, 3, |x, y| {
+            let g = if (x, y) == (2, 1) { bad } else { 0.5 };
+            (0.5f32, g, 0.5f32, 1.0f32)
+        })
+        .unwrap();
+        let e = load_texture(&path, TextureKind::Albedo).unwrap_err();
+        assert!(matches!(e, TextureError::NonFinite { x: 2, y: 1, .. }), "{name}: {e}");
+        assert!(e.to_string().contains("texel (2, 1) holds"), "{e}");
+    }
+}

@@ -12,6 +12,7 @@ use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Scene, TextureImage};
 use crate::shader_interface::MAX_TEXTURES;
+use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::texture::lean;
 use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
 use crate::RenderError;
@@ -67,20 +68,126 @@ pub struct GpuScene {
     pub origin: DVec3,
 }
 
-/// Uploads a texture with its mip chain as an RGBA32F image.
-fn upload_texture(device: &Arc<Device>, cmds: &mut Commands, t: &TextureImage) -> Result<Image, RenderError> {
-    let texels: Vec<[f32; 4]> = t.levels.iter().flatten().copied().collect();
-    let staging = Buffer::with_data(device, "texture upload", &texels, vk::BufferUsageFlags::TRANSFER_SRC)?;
-    let image = Image::with_levels(
+/// Host-visible memory a texture upload stages at most at once: larger maps
+/// go up in pieces of whole rows.
+const STAGING_BYTES: u64 = 64 << 20;
+
+/// The Vulkan format of a texel encoding.
+fn texel_format(encoding: TexelEncoding) -> vk::Format {
+    match encoding {
+        TexelEncoding::F32 => vk::Format::R32G32B32A32_SFLOAT,
+        TexelEncoding::F16 => vk::Format::R16G16B16A16_SFLOAT,
+        TexelEncoding::Srgb8 => vk::Format::R8G8B8A8_SRGB,
+        TexelEncoding::Unorm8 => vk::Format::R8G8B8A8_UNORM,
+    }
+}
+
+const TEXTURE_USAGE: vk::ImageUsageFlags =
+    vk::ImageUsageFlags::from_raw(vk::ImageUsageFlags::SAMPLED.as_raw() | vk::ImageUsageFlags::TRANSFER_DST.as_raw());
+
+/// The most precise encoding of `t` that the device can hold in one
+/// allocation ([`choose_encoding`]); warns when it is not f32.
+pub fn texture_encoding(device: &Device, t: &TextureImage, content: MapContent) -> Result<TexelEncoding, RenderError> {
+    let extent = vk::Extent2D { width: t.width, height: t.height };
+    let levels = t.levels.len() as u32;
+    let mut failure = None;
+    let bytes = |e: TexelEncoding| {
+        match Image::memory_bytes(device, extent, levels, texel_format(e), e.texel_bytes(), TEXTURE_USAGE) {
+            Ok(Some(bytes)) => bytes,
+            // The device cannot make the image at all: count its texels
+            // (for the message), more than it can allocate.
+            Ok(None) => (chain_texels(t) * e.texel_bytes()).max(device.max_allocation_bytes + 1),
+            Err(err) => {
+                failure.get_or_insert(err);
+                u64::MAX
+            }
+        }
+    };
+    let chosen = choose_encoding(t, content, device.max_allocation_bytes, bytes);
+    if let Some(err) = failure {
+        return Err(err.into());
+    }
+    let encoding = chosen?;
+    if encoding != TexelEncoding::F32 {
+        log::warn!(
+            "texture `{}` ({} x {}) is stored as {encoding}: as 32-bit floats it would exceed the device's \
+             largest allocation ({} MiB)",
+            t.source,
+            t.width,
+            t.height,
+            device.max_allocation_bytes >> 20
+        );
+    }
+    Ok(encoding)
+}
+
+/// Uploads a texture with its mip chain in `encoding`, staging at most
+/// [`STAGING_BYTES`] at a time.
+pub fn upload_texture(
+    device: &Arc<Device>,
+    cmds: &mut Commands,
+    t: &TextureImage,
+    encoding: TexelEncoding,
+) -> Result<Image, RenderError> {
+    let extent = vk::Extent2D { width: t.width, height: t.height };
+    let image =
+        Image::with_levels(device, &t.source, extent, t.levels.len() as u32, texel_format(encoding), TEXTURE_USAGE)?;
+    let texel_bytes = encoding.texel_bytes();
+    let staging_size = (chain_texels(t) * texel_bytes).min(STAGING_BYTES);
+    let mut staging = Buffer::new(
         device,
-        &t.source,
-        vk::Extent2D { width: t.width, height: t.height },
-        t.levels.len() as u32,
-        vk::Format::R32G32B32A32_SFLOAT,
-        vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+        "texture upload",
+        staging_size,
+        vk::BufferUsageFlags::TRANSFER_SRC,
+        gpu_allocator::MemoryLocation::CpuToGpu,
     )?;
-    cmds.run(|_, cmd| image.upload_levels(cmd, &staging, 16))?;
+    cmds.run(|_, cmd| image.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL))?;
+    let mut regions = Vec::new();
+    let mut used = 0u64;
+    for (level, texels) in t.levels.iter().enumerate() {
+        let width = (t.width >> level).max(1) as u64;
+        let height = (t.height >> level).max(1) as u64;
+        let row_bytes = width * texel_bytes;
+        let mut row = 0u64;
+        while row < height {
+            let rows = (height - row).min((staging_size - used) / row_bytes);
+            if rows == 0 {
+                cmds.run(|_, cmd| image.copy_from_buffer(cmd, &staging, &regions))?;
+                (regions, used) = (Vec::new(), 0);
+                continue;
+            }
+            let first = (row * width) as usize;
+            let piece = &texels[first..first + (rows * width) as usize];
+            encoding.encode(piece, &mut staging.bytes_mut()[used as usize..(used + rows * row_bytes) as usize]);
+            regions.push(image.rows_region(level as u32, row as u32, rows as u32, used));
+            used += rows * row_bytes;
+            row += rows;
+        }
+    }
+    cmds.run(|_, cmd| {
+        image.copy_from_buffer(cmd, &staging, &regions);
+        image.transition(cmd, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+    })?;
     Ok(image)
+}
+
+/// What each texture of the scene holds: colour if every use of it is as an
+/// albedo map, data otherwise.
+fn map_contents(scene: &Scene) -> Vec<MapContent> {
+    let mut color = vec![false; scene.textures.len()];
+    let mut data = vec![false; scene.textures.len()];
+    for m in &scene.materials {
+        if let Some(i) = m.maps.albedo {
+            color[i] = true;
+        }
+        for i in [m.maps.normal, m.maps.roughness, m.maps.displacement.map(|(i, _)| i)].into_iter().flatten() {
+            data[i] = true;
+        }
+    }
+    if let Some(e) = scene.environment {
+        data[e.texture] = true;
+    }
+    color.iter().zip(&data).map(|(&c, &d)| if c && !d { MapContent::Color } else { MapContent::Data }).collect()
 }
 
 /// Rounds a box outward to f32.
@@ -186,14 +293,14 @@ impl GpuScene {
         if texture_count >= MAX_TEXTURES as usize {
             return Err(RenderError::TooManyTextures(texture_count));
         }
-        let mut textures = scene
-            .textures
-            .iter()
-            .chain(&derived)
-            .map(|t| upload_texture(device, cmds, t))
-            .collect::<Result<Vec<_>, _>>()?;
         let white = TextureImage { source: "white".into(), width: 1, height: 1, levels: vec![vec![[1.0; 4]]] };
-        textures.push(upload_texture(device, cmds, &white)?);
+        let contents = map_contents(scene);
+        let mut textures = Vec::with_capacity(texture_count + 1);
+        for (i, t) in scene.textures.iter().chain(&derived).chain([&white]).enumerate() {
+            let content = contents.get(i).copied().unwrap_or(MapContent::Data);
+            let encoding = texture_encoding(device, t, content)?;
+            textures.push(upload_texture(device, cmds, t, encoding)?);
+        }
         let (environment, env_cdf) = match scene.environment {
             Some(e) => {
                 let t = &scene.textures[e.texture];

@@ -40,6 +40,7 @@
 //! lookups of normal and displacement maps go through their slope moments
 //! instead ([`lean`]).
 
+pub mod encoding;
 pub mod lean;
 mod procedural;
 mod resample;
@@ -132,6 +133,19 @@ pub enum TextureError {
         format: &'static str,
         /// The decoder's message.
         message: String,
+    },
+    /// An EXR texel is NaN or infinite, which would turn every pixel that
+    /// sees it (through filtering, every pixel near it) into NaN.
+    #[error("{}: texel ({x}, {y}) holds {value}; texture values must be finite", .path.display())]
+    NonFinite {
+        /// The path.
+        path: PathBuf,
+        /// Column of the first such texel.
+        x: usize,
+        /// Row of the first such texel (row 0 at the top).
+        y: usize,
+        /// The value found there.
+        value: f32,
     },
     /// The file's format is not one of PNG, JPEG and EXR.
     #[error(
@@ -253,6 +267,16 @@ pub fn read_exr_image(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>), TextureE
 pub fn from_texels(source: String, width: u32, height: u32, texels: Vec<[f32; 4]>) -> TextureImage {
     let (width, height, texels) = resample_to_power_of_two(width, height, texels);
     TextureImage { source, width, height, levels: build_mips(width, height, texels) }
+}
+
+/// The sRGB opto-electronic transfer function: a linear value in [0, 1] to
+/// its sRGB encoding.
+pub fn linear_to_srgb(v: f32) -> f32 {
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 /// The sRGB electro-optical transfer function: an sRGB-encoded value in
@@ -414,6 +438,11 @@ fn read_exr(path: &Path) -> Result<Decoded, TextureError> {
     let planes: Vec<Vec<f32>> = colour.iter().map(|&i| values(i)).collect();
     let alpha_plane = alpha.map(values);
     let n = width * height;
+    let non_finite = planes.iter().chain(&alpha_plane).filter_map(|p| p.iter().position(|v| !v.is_finite())).min();
+    if let Some(k) = non_finite {
+        let value = planes.iter().chain(&alpha_plane).map(|p| p[k]).find(|v| !v.is_finite()).unwrap_or(f32::NAN);
+        return Err(TextureError::NonFinite { path: path.to_path_buf(), x: k % width, y: k / width, value });
+    }
     let texels = (0..n)
         .map(|k| {
             let a = alpha_plane.as_ref().map_or(1.0, |p| p[k]);

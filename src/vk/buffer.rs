@@ -79,6 +79,11 @@ impl Buffer {
         self.allocation.as_ref().and_then(|a| a.mapped_slice()).expect("buffer is not host visible")
     }
 
+    /// The (host-visible) buffer's memory, to write in place.
+    pub fn bytes_mut(&mut self) -> &mut [u8] {
+        self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).expect("buffer is not host visible")
+    }
+
     /// Copies `bytes` into the (host-visible) buffer at `offset`.
     pub fn write(&mut self, offset: usize, bytes: &[u8]) {
         let slice = self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).expect("buffer is not host visible");

@@ -36,6 +36,9 @@ pub struct Device {
     pub properties: vk::PhysicalDeviceProperties,
     /// Acceleration-structure limits.
     pub accel_properties: AccelProperties,
+    /// The largest single memory allocation the device promises
+    /// (`maxMemoryAllocationSize`, Vulkan 1.1): 2 GiB on lavapipe.
+    pub max_allocation_bytes: u64,
     /// Device name, for messages.
     pub name: String,
     /// The memory allocator (dropped before the device).
@@ -219,7 +222,8 @@ impl Device {
         let accel = ash::khr::acceleration_structure::Device::new(raw_instance, &raw);
 
         let mut as_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut as_props);
+        let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut as_props).push_next(&mut maintenance3);
         unsafe { raw_instance.get_physical_device_properties2(physical, &mut props2) };
         let accel_properties = AccelProperties {
             min_scratch_offset_alignment: as_props.min_acceleration_structure_scratch_offset_alignment,
@@ -246,6 +250,7 @@ impl Device {
             accel,
             properties,
             accel_properties,
+            max_allocation_bytes: maintenance3.max_memory_allocation_size,
             name,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
         }))

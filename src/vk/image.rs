@@ -90,39 +90,86 @@ impl Image {
             .layer_count(1)
     }
 
-    /// Records copying `buffer` into every mip level (tightly packed, level
-    /// after level, starting at byte 0) and leaves the image in
-    /// SHADER_READ_ONLY_OPTIMAL. `texel_bytes` is the size of one texel.
-    pub fn upload_levels(&self, cmd: vk::CommandBuffer, buffer: &Buffer, texel_bytes: u64) {
-        self.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
-        let mut offset = 0u64;
-        let regions: Vec<vk::BufferImageCopy> = (0..self.levels)
-            .map(|level| {
-                let w = (self.extent.width >> level).max(1);
-                let h = (self.extent.height >> level).max(1);
-                let region = vk::BufferImageCopy::default()
-                    .buffer_offset(offset)
-                    .image_subresource(
-                        vk::ImageSubresourceLayers::default()
-                            .aspect_mask(vk::ImageAspectFlags::COLOR)
-                            .mip_level(level)
-                            .layer_count(1),
-                    )
-                    .image_extent(vk::Extent3D { width: w, height: h, depth: 1 });
-                offset += w as u64 * h as u64 * texel_bytes;
-                region
-            })
-            .collect();
+    /// The device memory an image of this shape would take, without
+    /// allocating it; `None` if the device cannot make such an image at all
+    /// (beyond the format's largest extent, levels or resource size).
+    /// `texel_bytes` is the size of one texel of `format`.
+    pub fn memory_bytes(
+        device: &Device,
+        extent: vk::Extent2D,
+        levels: u32,
+        format: vk::Format,
+        texel_bytes: u64,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Option<u64>, VkError> {
+        let limits = unsafe {
+            device.instance.raw.get_physical_device_image_format_properties(
+                device.physical,
+                format,
+                vk::ImageType::TYPE_2D,
+                vk::ImageTiling::OPTIMAL,
+                usage,
+                vk::ImageCreateFlags::empty(),
+            )
+        };
+        let limits = match limits {
+            Ok(l) => l,
+            Err(vk::Result::ERROR_FORMAT_NOT_SUPPORTED) => return Ok(None),
+            Err(e) => return Err(e.into()),
+        };
+        let level0 = extent.width as u64 * extent.height as u64 * texel_bytes;
+        if extent.width > limits.max_extent.width
+            || extent.height > limits.max_extent.height
+            || levels > limits.max_mip_levels
+            || level0 > limits.max_resource_size
+        {
+            return Ok(None);
+        }
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
+            .mip_levels(levels)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let raw = unsafe { device.raw.create_image(&info, None) }?;
+        let size = unsafe { device.raw.get_image_memory_requirements(raw) }.size;
+        unsafe { device.raw.destroy_image(raw, None) };
+        Ok((size <= limits.max_resource_size).then_some(size))
+    }
+
+    /// A copy of `rows` rows of mip `level`, from row `first_row` on, packed
+    /// tightly in a buffer from byte `buffer_offset`.
+    pub fn rows_region(&self, level: u32, first_row: u32, rows: u32, buffer_offset: u64) -> vk::BufferImageCopy {
+        let w = (self.extent.width >> level).max(1);
+        vk::BufferImageCopy::default()
+            .buffer_offset(buffer_offset)
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .mip_level(level)
+                    .layer_count(1),
+            )
+            .image_offset(vk::Offset3D { x: 0, y: first_row as i32, z: 0 })
+            .image_extent(vk::Extent3D { width: w, height: rows, depth: 1 })
+    }
+
+    /// Records copying `regions` of `buffer` into the image, which must be in
+    /// TRANSFER_DST_OPTIMAL.
+    pub fn copy_from_buffer(&self, cmd: vk::CommandBuffer, buffer: &Buffer, regions: &[vk::BufferImageCopy]) {
         unsafe {
             self.device.raw.cmd_copy_buffer_to_image(
                 cmd,
                 buffer.raw,
                 self.raw,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &regions,
+                regions,
             )
         };
-        self.transition(cmd, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
     }
 
     /// Records a transition from `from` to `to`, making all earlier
