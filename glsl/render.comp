@@ -579,8 +579,10 @@ void main() {
     }
 
     vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + rand2(rng)), idx, rng);
-    // No NaN or Inf ever leaves the renderer.
-    if (any(isnan(radiance)) || any(isinf(radiance))) radiance = vec3(0.0);
+    // No NaN or Inf ever leaves the renderer: such a sample counts as black,
+    // and the accumulation's fourth channel counts only the finite samples,
+    // so that the host can report how many were dropped.
+    bool finite = !any(isnan(radiance)) && !any(isinf(radiance));
     ivec2 at = ivec2(pix);
-    imageStore(accum, at, imageLoad(accum, at) + vec4(radiance, 1.0));
+    imageStore(accum, at, imageLoad(accum, at) + (finite ? vec4(radiance, 1.0) : vec4(0.0)));
 }

@@ -372,6 +372,14 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(v) = out.volume_seconds {
         eprintln!("volume: {} camera rays per pixel; {v:.3} s", scene.volume.samples.saturating_mul(out.spp));
     }
+    if out.dropped_samples > 0 {
+        log::warn!(
+            "{} of {} samples came out NaN or infinite and were counted as black (a renderer bug: please report it \
+             with the scene)",
+            out.dropped_samples,
+            out.width as u64 * out.height as u64 * out.spp as u64
+        );
+    }
     let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
     eprintln!(
         "wrote {} ({}x{}, {} spp, {:.2} s on {})",

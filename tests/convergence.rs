@@ -65,7 +65,9 @@ fn render(ctx: &Context, scene: &Scene, spp: u32, seed: u32) -> RenderOutput {
     let mut s = scene.clone();
     s.image.spp = spp;
     s.image.seed = seed;
-    quadray::render_scene(ctx, &s, &mut |_, _| {}).unwrap()
+    let out = quadray::render_scene(ctx, &s, &mut |_, _| {}).unwrap();
+    common::assert_finite(&out);
+    out
 }
 
 fn rmse(a: &RenderOutput, b: &RenderOutput) -> f64 {

@@ -54,14 +54,14 @@ fn ewa_over_ray_cones_averages_a_fine_checkerboard() {
     let counters = ctx.counters();
     let render = |filter| {
         let variant = RenderVariant { filter, ..Default::default() };
-        quadray::render_scene_with(&ctx, &scene, variant, &mut |_, _| {}).unwrap()
+        common::finite(quadray::render_scene_with(&ctx, &scene, variant, &mut |_, _| {}).unwrap())
     };
     let (filtered, unfiltered) = (render(FILTER_RAY_CONES), render(FILTER_NONE));
     // The covariance mode's footprint at the first hit, through the radiance
     // of the albedo-only shading variant.
     let covariance = {
         let variant = RenderVariant { filter: FILTER_COVARIANCE, shading: SHADING_NONE, ..Default::default() };
-        quadray::render_scene_with(&ctx, &scene, variant, &mut |_, _| {}).unwrap()
+        common::finite(quadray::render_scene_with(&ctx, &scene, variant, &mut |_, _| {}).unwrap())
     };
     drop(ctx);
     common::assert_no_validation_errors(&counters);
@@ -125,7 +125,7 @@ fn filtering_adds_no_bias_without_textures() {
         let mut s = scene.clone();
         s.image.seed = seed;
         let variant = RenderVariant { filter, ..Default::default() };
-        let out = quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap();
+        let out = common::finite(quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap());
         assert!(out.radiance.iter().flatten().all(|v| v.is_finite()), "non-finite pixel (filter {filter})");
         out
     };
@@ -212,7 +212,7 @@ fn footprints_through_a_curved_mirror_average_the_reflected_checker() {
         let mut s = scene.clone();
         s.image.spp = spp;
         let variant = RenderVariant { filter, shading: SHADING_MIRRORED_ALBEDO, ..Default::default() };
-        quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap()
+        common::finite(quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap())
     };
     let reference = render(FILTER_NONE, MIRROR_REFERENCE_SPP);
     let modes = [

@@ -84,6 +84,7 @@ fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) {
     let ctx = common::context();
     let counters = ctx.counters();
     let out = quadray::render_scene(&ctx, &scene, &mut |_, _| {}).unwrap();
+    common::assert_finite(&out);
     drop(ctx);
     common::assert_no_validation_errors(&counters);
 

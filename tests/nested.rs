@@ -95,7 +95,9 @@ fn an_index_matched_inner_ball_is_invisible() {
     let render = |s: &Scene, seed: u32| {
         let mut s = s.clone();
         s.image.seed = seed;
-        quadray::render_scene(&ctx, &s, &mut |_, _| {}).unwrap()
+        let out = quadray::render_scene(&ctx, &s, &mut |_, _| {}).unwrap();
+        common::assert_finite(&out);
+        out
     };
     let (with, without) = (scene(true), scene(false));
     // Several independent renders of each scene, so that the noise estimate

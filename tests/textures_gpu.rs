@@ -77,6 +77,7 @@ fn colour_maps_follow_the_uv_mappings() {
     let ctx = common::context();
     let counters = ctx.counters();
     let out = quadray::render_scene(&ctx, &scene, &mut |_, _| {}).unwrap();
+    common::assert_finite(&out);
     drop(ctx);
     common::assert_no_validation_errors(&counters);
 

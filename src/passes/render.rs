@@ -41,6 +41,9 @@ pub struct RenderOutput {
     pub caustics: Option<CausticReport>,
     /// GPU time of the volume pass (s), when it ran.
     pub volume_seconds: Option<f64>,
+    /// Samples whose radiance came out NaN or infinite, counted as black
+    /// (0 in every test; the CLI warns otherwise).
+    pub dropped_samples: u64,
 }
 
 impl RenderOutput {
@@ -56,6 +59,7 @@ impl RenderOutput {
             render_seconds: 0.0,
             caustics: None,
             volume_seconds: None,
+            dropped_samples: 0,
         }
     }
 }
@@ -352,13 +356,12 @@ impl Renderer {
             full_barrier(d, cmd);
         })?;
         let sums: Vec<[f32; 4]> = self.readback.read();
-        let radiance = sums[..pixels]
-            .iter()
-            .map(|s| {
-                let n = s[3].max(1.0);
-                [s[0] / n, s[1] / n, s[2] / n]
-            })
-            .collect();
+        // The fourth channel counts the finite samples; the mean is over
+        // all samples, the dropped ones black.
+        let n = self.samples.max(1) as f32;
+        let radiance = sums[..pixels].iter().map(|s| [s[0] / n, s[1] / n, s[2] / n]).collect();
+        let dropped_samples =
+            sums[..pixels].iter().map(|s| (self.samples as f64 - s[3] as f64).round().max(0.0) as u64).sum();
         let mut aov: Vec<GpuAov> = self.aov.read();
         aov.truncate(pixels);
         Ok(RenderOutput {
@@ -371,6 +374,7 @@ impl Renderer {
             render_seconds: self.render_seconds,
             caustics: self.caustics.as_ref().map(|c| CausticReport { irradiance: Vec::new(), ..c.report.clone() }),
             volume_seconds: self.volume_seconds(),
+            dropped_samples,
         })
     }
 }

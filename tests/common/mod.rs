@@ -30,7 +30,7 @@ pub fn render_validated(scene: &Scene) -> quadray::passes::RenderOutput {
     let out = quadray::render_scene(&ctx, scene, &mut |_, _| {}).unwrap();
     drop(ctx);
     assert_no_validation_errors(&counters);
-    assert!(out.radiance.iter().flatten().all(|v| v.is_finite()), "non-finite pixel");
+    assert_finite(&out);
     out
 }
 
@@ -45,7 +45,20 @@ pub fn render_variant_validated(
     let out = quadray::render_scene_with(&ctx, scene, variant, &mut |_, _| {}).unwrap();
     drop(ctx);
     assert_no_validation_errors(&counters);
+    assert_finite(&out);
+    out
+}
+
+/// Asserts that no pixel is NaN or infinite and that no sample was (the
+/// renderer counts such samples as black and reports them).
+pub fn assert_finite(out: &quadray::passes::RenderOutput) {
     assert!(out.radiance.iter().flatten().all(|v| v.is_finite()), "non-finite pixel");
+    assert_eq!(out.dropped_samples, 0, "samples came out NaN or infinite");
+}
+
+/// `out`, after [`assert_finite`].
+pub fn finite(out: quadray::passes::RenderOutput) -> quadray::passes::RenderOutput {
+    assert_finite(&out);
     out
 }
 
