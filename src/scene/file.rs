@@ -1159,17 +1159,18 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
     }
     let background = raw.background.as_ref().map_or(Vec3::ZERO, |b| b.get_ref().get().as_vec3());
 
-    let mut textures = TextureCache::default();
-    let mut materials: Vec<Material> = Vec::with_capacity(raw.materials.len() + 1);
+    // Names first, then objects and lights, and only then the materials
+    // with their texture maps: an error in an object is reported without
+    // first generating or loading maps that can take many seconds.
+    let mut names: Vec<&String> = Vec::with_capacity(raw.materials.len());
     let mut material_lines = Vec::with_capacity(raw.materials.len());
     for (i, raw_material) in raw.materials.iter().enumerate() {
-        let span = raw_material.span();
         let m = raw_material.get_ref();
         let name = m.name.get_ref();
         if name.is_empty() {
             return Err(src.error(Some(m.name.span()), format!("materials[{i}].name"), "must not be empty"));
         }
-        if let Some(first) = materials.iter().position(|o| &o.name == name) {
+        if let Some(first) = names.iter().position(|&n| n == name) {
             let line: usize = material_lines[first];
             return Err(src.error(
                 Some(m.name.span()),
@@ -1177,19 +1178,19 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
                 format!("duplicate material name {name:?} (first defined at line {line} as materials[{first}])"),
             ));
         }
-        material_lines.push(src.line_of(span.start));
-        materials.push(build_material(src, i, raw_material, &mut textures)?);
+        names.push(name);
+        material_lines.push(src.line_of(raw_material.span().start));
     }
-    let user_materials = materials.len();
+    let user_materials = names.len();
 
+    let mut needs_default_material = false;
     let mut objects = Vec::with_capacity(raw.objects.len());
     for (i, o) in raw.objects.iter().enumerate() {
         let material = match &o.get_ref().material {
-            Some(name) => match materials[..user_materials].iter().position(|m| &m.name == name.get_ref()) {
+            Some(name) => match names.iter().position(|&n| n == name.get_ref()) {
                 Some(k) => k,
                 None => {
-                    let known: Vec<String> =
-                        materials[..user_materials].iter().map(|m| format!("{:?}", m.name)).collect();
+                    let known: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
                     let known = if known.is_empty() {
                         "no [[materials]] are defined".to_owned()
                     } else {
@@ -1203,9 +1204,7 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
                 }
             },
             None => {
-                if materials.len() == user_materials {
-                    materials.push(Material::diffuse(DEFAULT_MATERIAL_NAME, Vec3::splat(0.8)));
-                }
+                needs_default_material = true;
                 user_materials
             }
         };
@@ -1213,6 +1212,15 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
     }
 
     let lights = raw.lights.iter().enumerate().map(|(i, l)| build_light(src, i, l)).collect::<Result<Vec<_>, _>>()?;
+
+    let mut textures = TextureCache::default();
+    let mut materials: Vec<Material> = Vec::with_capacity(user_materials + 1);
+    for (i, raw_material) in raw.materials.iter().enumerate() {
+        materials.push(build_material(src, i, raw_material, &mut textures)?);
+    }
+    if needs_default_material {
+        materials.push(Material::diffuse(DEFAULT_MATERIAL_NAME, Vec3::splat(0.8)));
+    }
 
     let environment = match &raw.environment {
         Some(e) => Some(build_environment(src, e.get_ref(), &mut textures)?),
@@ -2695,6 +2703,23 @@ mod tests {
         let missing = dir.path().join("tex/nope.png").display().to_string();
         assert!(e.contains(":6:23: materials[0].albedo_map.file: cannot load the albedo map: "), "{e}");
         assert!(e.contains(&format!("{missing}: no such file")), "{e}");
+    }
+
+    #[test]
+    fn objects_are_checked_before_maps_are_loaded() {
+        // An unbounded object is reported even though the material's map is
+        // missing: maps (which can take seconds to load or generate) come
+        // last.
+        let text = format!(
+            "{CAMERA}[[materials]]\nname = \"m\"\nalbedo_map = \"nope.png\"\n\
+             [[objects]]\nname = \"floor\"\nmaterial = \"m\"\nplane = {{}}\n"
+        );
+        let e = parse_scene(&text, "t.toml").unwrap_err().to_string();
+        assert!(e.contains("objects[0].plane: the plane surface is unbounded"), "{e}");
+        // A bounded object: now the map is loaded, and its error reported.
+        let text = text.replace("plane = {}", "plane = {}\nclip = { min = [-1, -1, -1], max = [1, 1, 1] }");
+        let e = parse_scene(&text, "t.toml").unwrap_err().to_string();
+        assert!(e.contains("materials[0].albedo_map: cannot load the albedo map"), "{e}");
     }
 
     #[test]
