@@ -476,10 +476,12 @@ vec3 proceedFunctional(rayQueryEXT rq, float tmin, float tmax) {
     return bestPoint;
 }
 
-// The closest hit of o + t d, t in [tmin, tmax] (world space).
-SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
+// The closest hit of o + t d, t in [tmin, tmax] (world space); with
+// `anyHit`, any hit, with only its t and object (a shadow ray).
+SceneHit traceSceneWith(vec3 o, vec3 d, float tmin, float tmax, bool anyHit) {
     rayQueryEXT rq;
-    rayQueryInitializeEXT(rq, tlas, gl_RayFlagsNoneEXT, 0xFF, o, tmin, d, tmax);
+    uint flags = anyHit ? gl_RayFlagsTerminateOnFirstHitEXT : gl_RayFlagsNoneEXT;
+    rayQueryInitializeEXT(rq, tlas, flags, 0xFF, o, tmin, d, tmax);
     vec3 point = proceedFunctional(rq, tmin, tmax);
     SceneHit h;
     h.t = NO_ROOT;
@@ -493,6 +495,7 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
     if (rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionGeneratedEXT) {
         h.t = rayQueryGetIntersectionTEXT(rq, true);
         h.object = candidateObject(rq, true);
+        if (anyHit) return h;
         uint cell = candidateCell(rq, h.object, true);
         h.cell = cell;
         h.objectPoint = point;
@@ -506,6 +509,9 @@ SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) {
     }
     return h;
 }
+
+// The closest hit of o + t d, t in [tmin, tmax] (world space).
+SceneHit traceScene(vec3 o, vec3 d, float tmin, float tmax) { return traceSceneWith(o, d, tmin, tmax, false); }
 
 // The shape operator of the surface at a hit (the derivative of the outward
 // unit normal along the surface, positive on a convex bump) in the tangent

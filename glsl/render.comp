@@ -233,10 +233,44 @@ float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
 // Number of light-sampling choices: the lights, plus the environment.
 uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
 
+// Shadow rays are not traced where next-event estimation makes them: they
+// wait in this queue and tracePath traces them at the same call site as
+// its own rays. Every call site of the intersection code is a full copy of
+// it in the compiled shader (Mesa inlines every function), so one site
+// instead of four makes the render shader compile about twice as fast on
+// lavapipe. At most two wait at a time (an equiangular estimate in a medium
+// and one at the surface behind it).
+struct ShadowRay {
+    vec3 origin;
+    vec3 dir;
+    float dist;
+    uint light;        // the light it aims at (frame.lightCount: the environment)
+};
+// Two slots in named variables rather than an array: dynamically indexed
+// arrays go to scratch memory on lavapipe.
+ShadowRay shadowRay0, shadowRay1;
+vec3 shadowRadiance0, shadowRadiance1;  // what each brings if nothing blocks it
+uint shadowRayCount = 0u;
+
+// Queues shadow ray `r`, which brings `radiance` if unblocked.
+void queueShadowRay(ShadowRay r, vec3 radiance) {
+    if (all(equal(radiance, vec3(0.0)))) return;
+    if (shadowRayCount == 0u) {
+        shadowRay0 = r;
+        shadowRadiance0 = radiance;
+    } else {
+        shadowRay1 = r;
+        shadowRadiance1 = radiance;
+    }
+    shadowRayCount = min(shadowRayCount + 1u, 2u);
+}
+
 // Next-event estimation at a vertex with a non-delta material: one light
-// chosen uniformly. `mis` is false at the last vertex, where no BSDF-sampled
+// chosen uniformly. Returns the light's contribution if its shadow ray `sr`
+// is unblocked. `mis` is false at the last vertex, where no BSDF-sampled
 // continuation competes.
-vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset, Medium med, bool mis, inout uint rng) {
+vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset, Medium med, bool mis, inout uint rng,
+               out ShadowRay sr) {
     uint choices = lightChoices();
     if (choices == 0u) return vec3(0.0);
     uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
@@ -251,7 +285,7 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset
     // part of the offset along the ray, so that the ray ends at the light.
     vec3 origin = offsetOrigin(p, ng, ls.wi, offset);
     float dist = ls.dist - dot(origin - p, ls.wi);
-    if (!lightVisible(origin, ls.wi, dist, i)) return vec3(0.0);
+    sr = ShadowRay(origin, ls.wi, dist, i);
     // The medium around the vertex attenuates the shadow ray (a shadow ray
     // that would cross into another medium meets its boundary and is
     // occluded above).
@@ -268,12 +302,13 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset
 // cosine, the shadow ray is attenuated by the medium's transmittance. Used
 // for the environment and directional lights; positional lights use the
 // equiangular estimate over the whole segment instead.
-vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis, inout uint rng) {
+vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis, inout uint rng, out ShadowRay sr) {
     LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
     float tr = transmittance(med, ls.dist);
-    if (tr == 0.0 || !lightVisible(p, ls.wi, ls.dist, i)) return vec3(0.0);
+    if (tr == 0.0) return vec3(0.0);
+    sr = ShadowRay(p, ls.wi, ls.dist, i);
     vec3 contribution = phase * tr * ls.radiance / select;
     if (ls.pdf == 0.0) return contribution;  // delta light
     float w = mis ? powerHeuristic(ls.pdf * select, phase) : 1.0;
@@ -287,7 +322,8 @@ vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis,
 // sampling, density σ_t T(t), then the phase function); `mis` is false when
 // the path cannot continue (its last vertex). Returns the estimate before
 // the segment's throughput (it includes σ_s and both transmittances).
-vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float select, bool mis, inout uint rng) {
+vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float select, bool mis, inout uint rng,
+                          out ShadowRay sr) {
     Equiangular e = equiangularSetup(o, d, tEnd, lightCentre(i));
     float t = equiangularSample(e, rand(rng));
     float pt = equiangularPdf(e, t);
@@ -296,7 +332,7 @@ vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float 
     LightSample ls = sampleLight(lights[i], x, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
-    if (!lightVisible(x, ls.wi, ls.dist, i)) return vec3(0.0);
+    sr = ShadowRay(x, ls.wi, ls.dist, i);
     float tAlong = exp(-med.density * t);
     vec3 f = (tAlong * transmittance(med, ls.dist) * med.density * phase) * v3(med.albedo) * ls.radiance;
     if (ls.pdf == 0.0) return f / (select * pt);  // point light
@@ -355,15 +391,35 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     // segment and the volume pass covers it (VOLUME_ENABLED).
     bool scatteredOnVolumeSegment = false;
     // Crossing an index-matched interface (relative index 1: the same medium
-    // on both sides) is not a bounce; `step` bounds the loop all the same.
+    // on both sides) is not a bounce; `step` bounds the path all the same.
     uint bounce = 0u;
-    for (uint step = 0u; bounce < frame.maxDepth && step < 4u * frame.maxDepth + 8u; ++step) {
-        SceneHit h = traceScene(o, d, 0.0, 1e30);
+    uint step = 0u;
+    bool alive = true;
+    ShadowRay sr;
+    // One ray query per iteration, at this one call site: a waiting shadow
+    // ray first, else the path's next segment.
+    for (;;) {
+        bool shadow = shadowRayCount > 0u;
+        if (!shadow && !(alive && bounce < frame.maxDepth && step < 4u * frame.maxDepth + 8u)) break;
+        if (shadow) sr = shadowRayCount == 2u ? shadowRay1 : shadowRay0;
+        SceneHit h = traceSceneWith(shadow ? sr.origin : o, shadow ? sr.dir : d, 0.0, shadow ? sr.dist : 1e30, shadow);
+        if (shadow) {
+            vec3 brings = shadowRayCount == 2u ? shadowRadiance1 : shadowRadiance0;
+            --shadowRayCount;
+            // Unblocked by geometry, and by other sphere and rect lights
+            // (which are not in the acceleration structure).
+            float tLight;
+            if (h.object == NO_HIT && firstLightHit(sr.origin, sr.dir, sr.dist, sr.light, tLight) == frame.lightCount) {
+                radiance += brings;
+            }
+            continue;
+        }
+        uint segment = step++;
         // The camera ray's first segment: the volume pass has its single
         // scattering toward positional lights.
-        bool volumeSegment = VOLUME_ENABLED != 0u && step == 0u;
+        bool volumeSegment = VOLUME_ENABLED != 0u && segment == 0u;
         if (volumeSegment) radiance += vec3(volume[3u * pixel], volume[3u * pixel + 1u], volume[3u * pixel + 2u]);
-        if (BEAMS_ENABLED != 0u && step == 0u) radiance += FIXED_POINT_RGB(beamMap, pixel);
+        if (BEAMS_ENABLED != 0u && segment == 0u) radiance += FIXED_POINT_RGB(beamMap, pixel);
         bool afterVolumeScatter = scatteredOnVolumeSegment;
         scatteredOnVolumeSegment = false;
         float tl;
@@ -385,14 +441,21 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             bool last = bounce + 1u == frame.maxDepth;
             bool positional = choices > 0u && positionalLight(li);
             if (positional && !volumeSegment) {
-                radiance += throughput * equiangularNextEvent(med, o, d, tl, li, select, !last, rng);
+                vec3 c = equiangularNextEvent(med, o, d, tl, li, select, !last, rng, sr);
+                queueShadowRay(sr, throughput * c);
             }
             float ts = -log(1.0 - rand(rng)) / med.density;
             if (ts < tl) {
                 vec3 p = o + ts * d;
                 throughput *= v3(med.albedo);
-                if (choices > 0u && !positional) radiance += throughput * mediumNextEvent(med, d, p, li, select, !last, rng);
-                if (last) break;
+                if (choices > 0u && !positional) {
+                    vec3 c = mediumNextEvent(med, d, p, li, select, !last, rng, sr);
+                    queueShadowRay(sr, throughput * c);
+                }
+                if (last) {
+                    alive = false;
+                    continue;
+                }
                 vec3 wi = sampleHg(med.anisotropy, d, rand2(rng));
                 lastPdf = hgPdf(med.anisotropy, dot(d, wi));
                 lastPoint = p;
@@ -416,10 +479,10 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 o = p;
                 // A scattering event on the camera ray's first segment is a
                 // receiver of the beam map's volumetric caustics.
-                causticPath = BEAMS_ENABLED != 0u && step == 0u;
+                causticPath = BEAMS_ENABLED != 0u && segment == 0u;
                 causticSpeculars = 0u;
                 scatteredOnVolumeSegment = volumeSegment;
-                if (!survives(throughput, bounce, rng)) break;
+                if (!survives(throughput, bounce, rng)) alive = false;
                 ++bounce;
                 continue;
             }
@@ -443,7 +506,8 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             // sphere or rect light is the volume pass's.
             bool coveredByVolume = afterVolumeScatter && which != frame.lightCount;
             if (!coveredByCaustics && !coveredByVolume) radiance += throughput * le * w;
-            break;
+            alive = false;
+            continue;
         }
 
         vec3 ns;
@@ -486,11 +550,20 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         bool primaryReceiver = CAUSTICS_ENABLED != 0u && bounce == 0u && mat.kind == MATERIAL_DIFFUSE
             && receivers[pixel].object == h.object;
         if (primaryReceiver) radiance += throughput * v3(mat.albedo) / PI * FIXED_POINT_RGB(causticMap, pixel);
-        if (!isDelta(mat)) radiance += throughput * nextEvent(mat, frameW, wo, p, h.normal, h.offset, med, !last, rng);
-        if (last) break;
+        if (!isDelta(mat)) {
+            vec3 c = nextEvent(mat, frameW, wo, p, h.normal, h.offset, med, !last, rng, sr);
+            queueShadowRay(sr, throughput * c);
+        }
+        if (last) {
+            alive = false;
+            continue;
+        }
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
-        if (!bs.valid) break;
+        if (!bs.valid) {
+            alive = false;
+            continue;
+        }
         if (CAUSTICS_ENABLED != 0u) {
             // The caustic rays pass dielectrics by refraction (reflection
             // only under total internal reflection) and reflect off mirrors
@@ -550,7 +623,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         d = normalize(frameW * bs.wi);
         o = offsetOrigin(p, h.normal, d, h.offset);
 
-        if (!survives(throughput, bounce, rng)) break;
+        if (!survives(throughput, bounce, rng)) alive = false;
         ++bounce;
     }
     return radiance;
