@@ -24,6 +24,26 @@ pub struct Image {
     pub levels: u32,
 }
 
+/// A 2D, single-layer, optimally tiled image of `levels` mip levels.
+fn image_info(
+    extent: vk::Extent2D,
+    levels: u32,
+    format: vk::Format,
+    usage: vk::ImageUsageFlags,
+) -> vk::ImageCreateInfo<'static> {
+    vk::ImageCreateInfo::default()
+        .image_type(vk::ImageType::TYPE_2D)
+        .format(format)
+        .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
+        .mip_levels(levels)
+        .array_layers(1)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .tiling(vk::ImageTiling::OPTIMAL)
+        .usage(usage)
+        .sharing_mode(vk::SharingMode::EXCLUSIVE)
+        .initial_layout(vk::ImageLayout::UNDEFINED)
+}
+
 impl Image {
     /// Creates a device-local image of `format` and `usage`, in layout UNDEFINED.
     pub fn new(
@@ -45,17 +65,7 @@ impl Image {
         format: vk::Format,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, VkError> {
-        let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
-            .format(format)
-            .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
-            .mip_levels(levels)
-            .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(usage)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE)
-            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let info = image_info(extent, levels, format, usage);
         let raw = unsafe { device.raw.create_image(&info, None) }?;
         let mut this =
             Self { device: device.clone(), raw, view: vk::ImageView::null(), allocation: None, format, extent, levels };
@@ -125,17 +135,7 @@ impl Image {
         {
             return Ok(None);
         }
-        let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
-            .format(format)
-            .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
-            .mip_levels(levels)
-            .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(usage)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE)
-            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let info = image_info(extent, levels, format, usage);
         let raw = unsafe { device.raw.create_image(&info, None) }?;
         let size = unsafe { device.raw.get_image_memory_requirements(raw) }.size;
         unsafe { device.raw.destroy_image(raw, None) };
