@@ -41,24 +41,39 @@ layout(push_constant, scalar) uniform Push {
 // of a direction toward the light (the light's sampler) and one from the
 // phase function (area lights only; they also find the parts of a large
 // light that its sampler reaches at grazing angles, with high variance).
+//
+// Both directions are tested in one loop, so that the shadow-ray query
+// appears once in the compiled shader (Mesa inlines every call site; see
+// render.comp), with the random numbers drawn in the same order.
 vec3 scatteredAt(Medium fog, vec3 o, vec3 d, float t, uint i, inout uint rng) {
     vec3 x = o + t * d;
     vec3 sum = vec3(0.0);
-    LightSample ls = sampleLight(lights[i], x, rand2(rng));
-    if (ls.valid && lightVisible(x, ls.wi, ls.dist, i)) {
-        float phase = hgPdf(fog.anisotropy, dot(d, ls.wi));
-        vec3 f = transmittance(fog, ls.dist) * phase * ls.radiance;
-        sum += ls.pdf == 0.0 ? f : f * (powerHeuristic(ls.pdf, phase) / ls.pdf);
-    }
-    if (lights[i].kind == LIGHT_SPHERE || lights[i].kind == LIGHT_RECT) {
-        vec3 wi = sampleHg(fog.anisotropy, d, rand2(rng));
-        float tl = lightHit(lights[i], x, wi);
-        if (tl != NO_ROOT && lightVisible(x, wi, tl, i)) {
-            // The phase function's sample weighs phase / pdf = 1.
-            float phase = hgPdf(fog.anisotropy, dot(d, wi));
-            float w = powerHeuristic(phase, lightPdf(lights[i], x, wi));
-            sum += transmittance(fog, tl) * w * v3(lights[i].color);
+    bool area = lights[i].kind == LIGHT_SPHERE || lights[i].kind == LIGHT_RECT;
+    [[dont_unroll]] for (uint strategy = 0u; strategy < (area ? 2u : 1u); ++strategy) {
+        vec3 wi;
+        float dist;
+        vec3 contribution = vec3(0.0);
+        if (strategy == 0u) {
+            // The light's sampler.
+            LightSample ls = sampleLight(lights[i], x, rand2(rng));
+            wi = ls.wi;
+            dist = ls.dist;
+            if (ls.valid) {
+                float phase = hgPdf(fog.anisotropy, dot(d, ls.wi));
+                vec3 f = transmittance(fog, ls.dist) * phase * ls.radiance;
+                contribution = ls.pdf == 0.0 ? f : f * (powerHeuristic(ls.pdf, phase) / ls.pdf);
+            }
+        } else {
+            // The phase function's sample, which weighs phase / pdf = 1.
+            wi = sampleHg(fog.anisotropy, d, rand2(rng));
+            dist = lightHit(lights[i], x, wi);
+            if (dist != NO_ROOT) {
+                float phase = hgPdf(fog.anisotropy, dot(d, wi));
+                float w = powerHeuristic(phase, lightPdf(lights[i], x, wi));
+                contribution = transmittance(fog, dist) * w * v3(lights[i].color);
+            }
         }
+        if (any(notEqual(contribution, vec3(0.0))) && lightVisible(x, wi, dist, i)) sum += contribution;
     }
     return sum * (exp(-fog.density * t) * fog.density) * v3(fog.albedo);
 }
@@ -72,17 +87,23 @@ vec3 scatteredAt(Medium fog, vec3 o, vec3 d, float t, uint i, inout uint rng) {
 vec3 inScattered(Medium fog, vec3 o, vec3 d, float tEnd, uint i, inout uint rng) {
     Equiangular e = equiangularSetup(o, d, tEnd, lightCentre(i));
     vec3 sum = vec3(0.0);
-    float te = equiangularSample(e, rand(rng));
-    float pe = equiangularPdf(e, te);
-    if (te >= 0.0 && te < tEnd && pe > 0.0) {
-        float pd = fog.density * exp(-fog.density * te);
-        sum += scatteredAt(fog, o, d, te, i, rng) * (powerHeuristic(pe, pd) / pe);
-    }
-    float td = -log(1.0 - rand(rng)) / fog.density;
-    if (td < tEnd) {
-        float pd = fog.density * exp(-fog.density * td);
-        float pe2 = equiangularPdf(e, td);
-        if (pd > 0.0) sum += scatteredAt(fog, o, d, td, i, rng) * (powerHeuristic(pd, pe2) / pd);
+    // The two points in one loop: one call site of scatteredAt (above).
+    [[dont_unroll]] for (uint strategy = 0u; strategy < 2u; ++strategy) {
+        float t, weight;
+        bool valid;
+        if (strategy == 0u) {
+            t = equiangularSample(e, rand(rng));
+            float pe = equiangularPdf(e, t);
+            float pd = fog.density * exp(-fog.density * t);
+            valid = t >= 0.0 && t < tEnd && pe > 0.0;
+            weight = powerHeuristic(pe, pd) / pe;
+        } else {
+            t = -log(1.0 - rand(rng)) / fog.density;
+            float pd = fog.density * exp(-fog.density * t);
+            valid = t < tEnd && pd > 0.0;
+            weight = powerHeuristic(pd, equiangularPdf(e, t)) / pd;
+        }
+        if (valid) sum += scatteredAt(fog, o, d, t, i, rng) * weight;
     }
     return sum;
 }
