@@ -134,6 +134,8 @@ pub fn upload_texture(
         Image::with_levels(device, &t.source, extent, t.levels.len() as u32, texel_format(encoding), TEXTURE_USAGE)?;
     let texel_bytes = encoding.texel_bytes();
     let staging_size = (chain_texels(t) * texel_bytes).min(STAGING_BYTES);
+    // Pieces are whole rows: the widest (16384 texels of f32) is 256 KiB.
+    assert!(t.width as u64 * texel_bytes <= staging_size, "a texture row exceeds the staging buffer");
     let mut staging = Buffer::new(
         device,
         "texture upload",
@@ -172,7 +174,8 @@ pub fn upload_texture(
 }
 
 /// What each texture of the scene holds: colour if every use of it is as an
-/// albedo map, data otherwise.
+/// albedo map or the environment (both sRGB-decoded when read from PNG or
+/// JPEG), data otherwise.
 fn map_contents(scene: &Scene) -> Vec<MapContent> {
     let mut color = vec![false; scene.textures.len()];
     let mut data = vec![false; scene.textures.len()];
@@ -185,7 +188,7 @@ fn map_contents(scene: &Scene) -> Vec<MapContent> {
         }
     }
     if let Some(e) = scene.environment {
-        data[e.texture] = true;
+        color[e.texture] = true;
     }
     color.iter().zip(&data).map(|(&c, &d)| if c && !d { MapContent::Color } else { MapContent::Data }).collect()
 }

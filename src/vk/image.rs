@@ -136,7 +136,9 @@ impl Image {
             return Ok(None);
         }
         let info = image_info(extent, levels, format, usage);
-        let raw = unsafe { device.raw.create_image(&info, None) }?;
+        // A device that cannot even describe the image (out of memory for
+        // its bookkeeping, say) cannot make it: not an error, a "no".
+        let Ok(raw) = (unsafe { device.raw.create_image(&info, None) }) else { return Ok(None) };
         let size = unsafe { device.raw.get_image_memory_requirements(raw) }.size;
         unsafe { device.raw.destroy_image(raw, None) };
         Ok((size <= limits.max_resource_size).then_some(size))
