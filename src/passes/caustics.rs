@@ -290,7 +290,7 @@ impl CausticMap {
         )?;
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
         let kinds = binding_kinds();
-        let intersect = super::render::intersect_mode(scene, crate::shader_interface::INTERSECT_FULL);
+        let intersect = gpu.intersect_mode(crate::shader_interface::INTERSECT_FULL);
         let specialisation = [intersect, 0, 0, u32::from(scene.has_media())];
         let push = std::mem::size_of::<GpuEmitter>() as u32;
         let gbuffer = ComputePipeline::new(device, &shaders::gbuffer(), &kinds, push, &specialisation)?;

@@ -9,9 +9,7 @@ use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, RenderP
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::volume::VolumeLight;
 use crate::scene::Scene;
-use crate::shader_interface::{
-    FILTER_NONE, INTERSECT_BASE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL,
-};
+use crate::shader_interface::{FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
 use crate::vk::{
     full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
 };
@@ -186,7 +184,7 @@ impl Renderer {
         )?;
         let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant)?;
         let volume = if variant.volume && variant.shading == SHADING_FULL && scene.needs_volume() {
-            Some(VolumeLight::new(device, gpu, &frame, (width, height), intersect_mode(scene, INTERSECT_FULL))?)
+            Some(VolumeLight::new(device, gpu, &frame, (width, height))?)
         } else {
             None
         };
@@ -214,7 +212,7 @@ impl Renderer {
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
-        let pipeline = render_pipeline(device, scene, variant, caustics.as_ref(), volume.is_some())?;
+        let pipeline = render_pipeline(device, gpu, scene, variant, caustics.as_ref(), volume.is_some())?;
         {
             let receivers = caustics.as_ref().map_or(&placeholder, |c| &c.receivers);
             let caustic_map = caustics.as_ref().map_or(&placeholder, |c| &c.map);
@@ -379,20 +377,10 @@ impl Renderer {
     }
 }
 
-/// The intersection mode the shaders are specialised with: `requested`,
-/// except that a scene without perturbations needs no more than the base
-/// quadrics' roots ([`Scene::has_perturbations`]).
-pub fn intersect_mode(scene: &Scene, requested: u32) -> u32 {
-    if requested == INTERSECT_FULL && !scene.has_perturbations() {
-        INTERSECT_BASE
-    } else {
-        requested
-    }
-}
-
 /// The render shader specialised for `variant` and the passes that run.
 fn render_pipeline(
     device: &Arc<Device>,
+    gpu: &GpuScene,
     scene: &Scene,
     variant: RenderVariant,
     caustics: Option<&CausticMap>,
@@ -416,7 +404,7 @@ fn render_pipeline(
         &kinds,
         std::mem::size_of::<RenderPush>() as u32,
         &[
-            intersect_mode(scene, variant.intersect),
+            gpu.intersect_mode(variant.intersect),
             variant.shading,
             variant.filter,
             u32::from(scene.has_media()),

@@ -11,7 +11,7 @@ use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
 use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Scene, TextureImage};
-use crate::shader_interface::MAX_TEXTURES;
+use crate::shader_interface::{INTERSECT_BASE, INTERSECT_FULL, MAX_TEXTURES};
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::texture::lean;
 use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
@@ -348,6 +348,19 @@ impl GpuScene {
         let white = self.textures.last().expect("the white texture");
         let images = (0..MAX_TEXTURES as usize).map(|i| self.textures.get(i).unwrap_or(white)).collect();
         Binding::Textures(images, &self.sampler)
+    }
+
+    /// The intersection mode to specialise shaders with: `requested`, except
+    /// that a scene without perturbations needs no more than the base
+    /// quadrics' roots (`INTERSECT_BASE`, the same hits), which leaves the
+    /// perturbation code and its f64 root refinement out of the shaders:
+    /// they compile several times faster on lavapipe.
+    pub fn intersect_mode(&self, requested: u32) -> u32 {
+        if requested == INTERSECT_FULL && self.stats.perturbations == 0 {
+            INTERSECT_BASE
+        } else {
+            requested
+        }
     }
 
     /// The bindings `BINDING_TLAS..=BINDING_FRAME` of the passes that trace

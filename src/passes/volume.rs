@@ -39,20 +39,18 @@ impl VolumeLight {
         size: (u32, u32),
         samples: u32,
     ) -> Result<Self, RenderError> {
-        let mut pass = Self::new(device, gpu, frame, size, INTERSECT_FULL)?;
+        let mut pass = Self::new(device, gpu, frame, size)?;
         pass.run(cmds, &GpuTimer::new(device)?, samples)?;
         Ok(pass)
     }
 
     /// Creates the pipeline and the output for a `width` x `height` image
-    /// whose frame parameters are in `frame` (`GpuFrame`), its shader
-    /// specialised with the intersection mode `intersect`; nothing runs yet.
+    /// whose frame parameters are in `frame` (`GpuFrame`); nothing runs yet.
     pub fn new(
         device: &Arc<Device>,
         gpu: &GpuScene,
         frame: &Buffer,
         (width, height): (u32, u32),
-        intersect: u32,
     ) -> Result<Self, RenderError> {
         let radiance = Buffer::new(
             device,
@@ -63,7 +61,8 @@ impl VolumeLight {
         )?;
         let mut kinds = vec![BindingKind::AccelerationStructure];
         kinds.extend([BindingKind::StorageBuffer; 8]);
-        let pipeline = ComputePipeline::new(device, &shaders::volume(), &kinds, 12, &[intersect])?;
+        let pipeline =
+            ComputePipeline::new(device, &shaders::volume(), &kinds, 12, &[gpu.intersect_mode(INTERSECT_FULL)])?;
         let mut bindings = gpu.frame_bindings(frame);
         bindings.push(Binding::Buffer(&radiance));
         pipeline.bind(&bindings);

@@ -359,14 +359,6 @@ impl Scene {
         self.fog.iter().chain(self.materials.iter().filter_map(|m| m.medium.as_ref())).any(|m| m.density > 0.0)
     }
 
-    /// True when an object has a perturbation. Without any, the shaders are
-    /// specialised to intersect base quadrics only (`INTERSECT_BASE`, the
-    /// same hits), which leaves the perturbation code and its f64 root
-    /// refinement out of them: they compile several times faster on lavapipe.
-    pub fn has_perturbations(&self) -> bool {
-        self.objects.iter().any(|o| !o.shape.perturbations.is_empty())
-    }
-
     /// True when the volume pass has work: volume samples are enabled, and
     /// the scene has fog and a point, sphere or rect light.
     pub fn needs_volume(&self) -> bool {
