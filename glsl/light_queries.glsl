@@ -23,14 +23,19 @@ uint firstLightHit(vec3 o, vec3 d, float tmax, uint except, out float tHit) {
     return which;
 }
 
+// True when no sphere or rect light other than `i` lies on the shadow ray
+// before `dist` (lights are not in the acceleration structure).
+bool noOtherLightInFront(vec3 origin, vec3 wi, float dist, uint i) {
+    float tl;
+    return firstLightHit(origin, wi, dist, i, tl) == frame.lightCount;
+}
+
 // True when nothing blocks the shadow ray from `origin` along wi over
 // `dist` toward light `i`: no geometry, and no other sphere or rect light in
 // front (lights are not in the acceleration structure, so they may hide
 // each other).
 bool lightVisible(vec3 origin, vec3 wi, float dist, uint i) {
-    if (occluded(origin, wi, 0.0, dist)) return false;
-    float tl;
-    return firstLightHit(origin, wi, dist, i, tl) == frame.lightCount;
+    return !occluded(origin, wi, 0.0, dist) && noOtherLightInFront(origin, wi, dist, i);
 }
 
 // True for lights with a position (point, sphere, rect): the ones the

@@ -86,8 +86,7 @@ impl Buffer {
 
     /// Copies `bytes` into the (host-visible) buffer at `offset`.
     pub fn write(&mut self, offset: usize, bytes: &[u8]) {
-        let slice = self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).expect("buffer is not host visible");
-        slice[offset..offset + bytes.len()].copy_from_slice(bytes);
+        self.bytes_mut()[offset..offset + bytes.len()].copy_from_slice(bytes);
     }
 
     /// Reads the (host-visible) buffer as a vector of `T`.
