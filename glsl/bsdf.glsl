@@ -60,12 +60,23 @@ float ggxD(vec3 m, float a) {
 float ggxLambda(vec3 w, float a) {
     float z2 = w.z * w.z;
     if (z2 <= 0.0) return 1e30;
-    float q = a * a * (w.x * w.x + w.y * w.y) / z2;
+    // Capped: a denormal cos² would overflow q to +inf, and inf / inf is NaN.
+    float q = min(a * a * (w.x * w.x + w.y * w.y) / z2, 1e30);
     return q / (2.0 * (sqrt(1.0 + q) + 1.0));
 }
 
 float ggxG1(vec3 w, float a) { return 1.0 / (1.0 + ggxLambda(w, a)); }
 float ggxG2(vec3 wo, vec3 wi, float a) { return 1.0 / (1.0 + ggxLambda(wo, a) + ggxLambda(wi, a)); }
+
+// G2(wo, wi) / G1(wo) = (1 + Λ(wo)) / (1 + Λ(wo) + Λ(wi)), the weight of a
+// visible-normal sample before Fresnel. Written as one quotient it is at
+// most 1 in f32 too (the denominator rounds to at least the numerator, as
+// Λ ≥ 0), so a sample's weight never exceeds its bound; G2 / G1 computed
+// apart can exceed 1 by a rounding step at grazing angles.
+float ggxG2OverG1(vec3 wo, vec3 wi, float a) {
+    float n = 1.0 + ggxLambda(wo, a);
+    return n / (n + ggxLambda(wi, a));
+}
 
 // Visible normals: E. Heitz, "Sampling the GGX Distribution of Visible
 // Normals", JCGT 2018. Requires wo.z > 0.
@@ -239,7 +250,7 @@ BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
             i = 2.0 * c * m - o;
             if (i.z <= 0.0) return s;
             s.pdf = f * ggxVisiblePdf(o, m, a) / (4.0 * c);
-            s.weight = vec3(ggxG2(o, i, a) / ggxG1(o, a));
+            s.weight = vec3(ggxG2OverG1(o, i, a));
         } else {
             float sin2T = (1.0 - c * c) / (eta * eta);
             if (sin2T >= 1.0) return s;
@@ -248,7 +259,7 @@ BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
             if (i.z >= 0.0) return s;
             float den = c - eta * cosT;
             s.pdf = (1.0 - f) * ggxVisiblePdf(o, m, a) * eta * eta * cosT / (den * den);
-            s.weight = vec3(ggxG2(o, i, a) / (ggxG1(o, a) * eta * eta));
+            s.weight = vec3(ggxG2OverG1(o, i, a) / (eta * eta));
         }
         s.wi = vec3(i.xy, sgn * i.z);
         s.valid = s.pdf > 0.0 && !isinf(s.pdf) && !isnan(s.pdf);
@@ -292,7 +303,7 @@ BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
         s.wi = 2.0 * om * m - wo;
         if (s.wi.z <= 0.0 || om <= 0.0) return s;
         s.pdf = ggxVisiblePdf(wo, m, a) / (4.0 * om);
-        s.weight = conductorFresnel(mat, om) * (ggxG2(wo, s.wi, a) / ggxG1(wo, a));
+        s.weight = conductorFresnel(mat, om) * ggxG2OverG1(wo, s.wi, a);
         s.valid = s.pdf > 0.0;
         return s;
     }

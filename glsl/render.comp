@@ -24,6 +24,7 @@ struct Aov {
     float depth;
     float normal[3];
     float albedo[3];
+    uint object;    // the object hit (NO_HIT on a miss)
 };
 layout(set = 0, binding = BINDING_AOV, scalar) writeonly buffer Aovs { Aov aovs[]; };
 
@@ -207,6 +208,47 @@ layout(push_constant, scalar) uniform Push {
     uint writeAov;
 } pc;
 
+// The largest single sample per pixel: r its luminance, g the sample index
+// that brought it (exact up to 2^24 samples). The outlier report
+// (src/passes/outliers.rs) compares it with the bound the scene allows.
+layout(set = 0, binding = BINDING_RENDER_MAX_SAMPLE, rg32f) uniform image2D maxSample;
+
+// Specialisation constant: 1 records every event of the path into `path`
+// (one pixel and one sample per dispatch: the outlier report's); 0 compiles
+// the recording out.
+layout(constant_id = 7) const uint RECORD_PATH = 0u;
+
+// One recorded event (host twin: GpuPathVertex in src/passes/gpu.rs).
+struct PathVertex {
+    uint event;         // EVENT_*
+    uint object;        // object index, or the light index for emitters and light samples
+    uint material;      // material index (NO_TEXTURE when none)
+    uint lobe;          // LOBE_* (surface events), or the light kind
+    float t;            // ray parameter of the hit, or the shadow ray's length
+    float cosO;         // cosine of wo with the shading normal (signed)
+    float cosI;         // cosine of wi with the shading normal (signed)
+    float pdf;          // solid-angle pdf of the sample (0: delta), or the MIS weight for emitters
+    float position[3];
+    float weight[3];    // the sample's weight, or the contribution an emitter or shadow ray brings
+    float throughput[3];
+    float radiance[3];  // the sample's radiance so far
+};
+layout(set = 0, binding = BINDING_RENDER_PATH, scalar) buffer PathRecord {
+    uint count;
+    PathVertex vertices[PATH_RECORD_VERTICES];
+} path;
+
+void record(uint event, uint object, uint material, uint lobe, float t, float cosO, float cosI, float pdf, vec3 position,
+            vec3 weight, vec3 throughput, vec3 radiance) {
+    if (RECORD_PATH == 0u) return;
+    uint i = path.count;
+    if (i >= PATH_RECORD_VERTICES) return;
+    path.count = i + 1u;
+    path.vertices[i] = PathVertex(event, object, material, lobe, t, cosO, cosI, pdf, float[3](position.x, position.y,
+        position.z), float[3](weight.x, weight.y, weight.z), float[3](throughput.x, throughput.y, throughput.z),
+        float[3](radiance.x, radiance.y, radiance.z));
+}
+
 // Specialisation constant: SHADING_FULL, SHADING_NONE (the first hit's
 // albedo: no light sampling, no bounces; benchmark breakdowns) or
 // SHADING_MIRRORED_ALBEDO (the albedo seen through perfect mirrors; tests).
@@ -255,6 +297,8 @@ uint shadowRayCount = 0u;
 // Queues shadow ray `r`, which brings `radiance` if unblocked.
 void queueShadowRay(ShadowRay r, vec3 radiance) {
     if (all(equal(radiance, vec3(0.0)))) return;
+    record(EVENT_LIGHT_SAMPLE, r.light, NO_TEXTURE, r.light < frame.lightCount ? lights[r.light].kind : NO_HIT, r.dist,
+           0.0, 0.0, 0.0, r.origin, radiance, vec3(0.0), vec3(0.0));
     if (shadowRayCount == 0u) {
         shadowRay0 = r;
         shadowRadiance0 = radiance;
@@ -266,10 +310,11 @@ void queueShadowRay(ShadowRay r, vec3 radiance) {
 }
 
 // Next-event estimation at a vertex with a non-delta material: one light
-// chosen uniformly. Returns the light's contribution if its shadow ray `sr`
-// is unblocked. `mis` is false at the last vertex, where no BSDF-sampled
-// continuation competes.
-vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset, Medium med, bool mis, inout uint rng,
+// chosen uniformly, weighted by multiple importance sampling against the
+// BSDF-sampled continuation (which every vertex has, the last one included:
+// see "the last vertex" in tracePath). Returns the light's contribution if
+// its shadow ray `sr` is unblocked.
+vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 d, vec3 p, vec3 ng, float offset, Medium med, inout uint rng,
                out ShadowRay sr) {
     uint choices = lightChoices();
     if (choices == 0u) return vec3(0.0);
@@ -278,6 +323,12 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset
     LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     vec3 wiLocal = transpose(frameW) * ls.wi;
+    // The light must lie on the side of the geometric surface that the
+    // lobe scatters to (the viewer's side for reflection, the other for
+    // transmission): a shading normal tilted by a normal or bump map would
+    // otherwise let light leak through the surface.
+    bool crosses = dot(ls.wi, ng) * dot(d, ng) > 0.0;
+    if (crosses != (wiLocal.z * wo.z < 0.0)) return vec3(0.0);
     vec3 f = bsdfEval(mat, wo, wiLocal);
     if (all(equal(f, vec3(0.0)))) return vec3(0.0);
     // The shadow ray starts off the surface on the side of the light (either
@@ -292,8 +343,7 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset
     vec3 contribution = f * abs(wiLocal.z) * ls.radiance * (transmittance(med, dist) / select);
     if (ls.pdf == 0.0) return contribution;  // delta light
     float pl = ls.pdf * select;
-    float w = mis ? powerHeuristic(pl, bsdfPdf(mat, wo, wiLocal)) : 1.0;
-    return contribution * (w / ls.pdf);
+    return contribution * (powerHeuristic(pl, bsdfPdf(mat, wo, wiLocal)) / ls.pdf);
 }
 
 // Next-event estimation at a scattering event in a medium, at p, for a path
@@ -302,7 +352,7 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 p, vec3 ng, float offset
 // cosine, the shadow ray is attenuated by the medium's transmittance. Used
 // for the environment and directional lights; positional lights use the
 // equiangular estimate over the whole segment instead.
-vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis, inout uint rng, out ShadowRay sr) {
+vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, inout uint rng, out ShadowRay sr) {
     LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
@@ -311,18 +361,17 @@ vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, bool mis,
     sr = ShadowRay(p, ls.wi, ls.dist, i);
     vec3 contribution = phase * tr * ls.radiance / select;
     if (ls.pdf == 0.0) return contribution;  // delta light
-    float w = mis ? powerHeuristic(ls.pdf * select, phase) : 1.0;
-    return contribution * (w / ls.pdf);
+    return contribution * (powerHeuristic(ls.pdf * select, phase) / ls.pdf);
 }
 
 // Single scattering toward positional light `i` (chosen with probability
 // `select`) along the medium segment o + t d, t in [0, tEnd): a point by
 // equiangular sampling, a direction by the light's sampler, weighted by
 // multiple importance sampling against the path's own strategy (distance
-// sampling, density σ_t T(t), then the phase function); `mis` is false when
-// the path cannot continue (its last vertex). Returns the estimate before
-// the segment's throughput (it includes σ_s and both transmittances).
-vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float select, bool mis, inout uint rng,
+// sampling, density σ_t T(t), then the phase function). Returns the
+// estimate before the segment's throughput (it includes σ_s and both
+// transmittances).
+vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float select, inout uint rng,
                           out ShadowRay sr) {
     Equiangular e = equiangularSetup(o, d, tEnd, lightCentre(i));
     float t = equiangularSample(e, rand(rng));
@@ -337,16 +386,24 @@ vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float 
     vec3 f = (tAlong * transmittance(med, ls.dist) * med.density * phase) * v3(med.albedo) * ls.radiance;
     if (ls.pdf == 0.0) return f / (select * pt);  // point light
     float pA = select * pt * ls.pdf;
-    float w = mis ? powerHeuristic(pA, med.density * tAlong * phase) : 1.0;
-    return f * (w / pA);
+    return f * (powerHeuristic(pA, med.density * tAlong * phase) / pA);
 }
 
-// Russian roulette after RR_DEPTH bounces: false when the path ends.
-bool survives(inout vec3 throughput, uint bounce, inout uint rng) {
+// Russian roulette after RR_DEPTH bounces: false when the path ends. The
+// survival probability is the throughput times `etaScale`, the product of
+// the η² factors that refractions divided the throughput by (radiance
+// scales by η² across an interface; Mitsuba 3 does the same), at most 1:
+// inside glass the throughput is 1/η² of what will leave it, and dividing
+// by that smaller probability would push the throughput above 1 when the
+// path leaves (a sample that gains energy). So the η-corrected throughput
+// never exceeds 1 (outliers.rs states the bound this gives).
+bool survives(inout vec3 throughput, float etaScale, uint bounce, inout uint rng) {
     if (bounce + 1u < RR_DEPTH) return true;
-    float q = clamp(max(throughput.x, max(throughput.y, throughput.z)), 0.05, 0.95);
+    float q = clamp(max(throughput.x, max(throughput.y, throughput.z)) * etaScale, 0.05, 1.0);
+    if (q >= 1.0) return true;
     if (rand(rng) > q) return false;
     throughput /= q;
+    record(EVENT_ROULETTE, NO_HIT, NO_TEXTURE, 0u, 0.0, 0.0, 0.0, q, vec3(0.0), vec3(1.0 / q), throughput, vec3(0.0));
     return true;
 }
 
@@ -373,6 +430,9 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     PathCovariance cov = covCamera(d, normalize(frame.up), pixelAngle);
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
+    // The product of the η² factors refractions divided the throughput by
+    // (Russian roulette's survival probability uses throughput × etaScale).
+    float etaScale = 1.0;
     float lastPdf = 0.0;      // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
     vec3 lastPoint = o;
     // After a scattering event in a medium: the segment it was on (origin,
@@ -392,6 +452,14 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     bool scatteredOnVolumeSegment = false;
     // Crossing an index-matched interface (relative index 1: the same medium
     // on both sides) is not a bounce; `step` bounds the path all the same.
+    // The last vertex: the path's vertex at bounce maxDepth - 1 still samples
+    // its BSDF, and the segment that follows (bounce == maxDepth) looks only
+    // for an emitter (a light, the environment, an emissive surface), so
+    // that next-event estimation at every vertex is weighted against BSDF
+    // sampling. Without it the last vertex's light sample is unweighted, and
+    // on a sharp glossy lobe one such sample is many times the light's
+    // radiance (Veach 1997, ch. 9; pbrt-v4 and Mitsuba 3 end paths the
+    // same way).
     uint bounce = 0u;
     uint step = 0u;
     bool alive = true;
@@ -400,17 +468,21 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     // ray first, else the path's next segment.
     for (;;) {
         bool shadow = shadowRayCount > 0u;
-        if (!shadow && !(alive && bounce < frame.maxDepth && step < 4u * frame.maxDepth + 8u)) break;
+        if (!shadow && !(alive && bounce <= frame.maxDepth && step < 4u * frame.maxDepth + 8u)) break;
         if (shadow) sr = shadowRayCount == 2u ? shadowRay1 : shadowRay0;
         SceneHit h = traceSceneWith(shadow ? sr.origin : o, shadow ? sr.dir : d, 0.0, shadow ? sr.dist : 1e30, shadow);
         if (shadow) {
             vec3 brings = shadowRayCount == 2u ? shadowRadiance1 : shadowRadiance0;
             --shadowRayCount;
             // lightVisible, with the geometry test done by the query above.
-            if (h.object == NO_HIT && noOtherLightInFront(sr.origin, sr.dir, sr.dist, sr.light)) radiance += brings;
+            bool visible = h.object == NO_HIT && noOtherLightInFront(sr.origin, sr.dir, sr.dist, sr.light);
+            if (visible) radiance += brings;
+            record(EVENT_SHADOW, sr.light, NO_TEXTURE, visible ? 1u : 0u, sr.dist, 0.0, 0.0, visible ? 1.0 : 0.0,
+                   sr.origin + sr.dist * sr.dir, brings, throughput, radiance);
             continue;
         }
         uint segment = step++;
+        bool emitterOnly = bounce == frame.maxDepth;
         // The camera ray's first segment: the volume pass has its single
         // scattering toward positional lights.
         bool volumeSegment = VOLUME_ENABLED != 0u && segment == 0u;
@@ -436,24 +508,28 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             float select = 1.0 / float(max(choices, 1u));
             bool last = bounce + 1u == frame.maxDepth;
             bool positional = choices > 0u && positionalLight(li);
-            if (positional && !volumeSegment) {
-                vec3 c = equiangularNextEvent(med, o, d, tl, li, select, !last, rng, sr);
+            if (positional && !volumeSegment && !emitterOnly) {
+                vec3 c = equiangularNextEvent(med, o, d, tl, li, select, rng, sr);
                 queueShadowRay(sr, throughput * c);
             }
             float ts = -log(1.0 - rand(rng)) / med.density;
+            if (ts < tl && emitterOnly) {
+                // Scattered before reaching an emitter: that light would
+                // take one bounce more than the path may have.
+                alive = false;
+                continue;
+            }
             if (ts < tl) {
                 vec3 p = o + ts * d;
                 throughput *= v3(med.albedo);
                 if (choices > 0u && !positional) {
-                    vec3 c = mediumNextEvent(med, d, p, li, select, !last, rng, sr);
+                    vec3 c = mediumNextEvent(med, d, p, li, select, rng, sr);
                     queueShadowRay(sr, throughput * c);
-                }
-                if (last) {
-                    alive = false;
-                    continue;
                 }
                 vec3 wi = sampleHg(med.anisotropy, d, rand2(rng));
                 lastPdf = hgPdf(med.anisotropy, dot(d, wi));
+                record(EVENT_MEDIUM, NO_HIT, NO_TEXTURE, LOBE_REFLECT, ts, 0.0, dot(d, wi), lastPdf, p, v3(med.albedo),
+                       throughput, radiance);
                 lastPoint = p;
                 // For the weight of a positional light this direction may hit.
                 scatterSegment = vec4(o, tl);
@@ -478,7 +554,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 causticPath = BEAMS_ENABLED != 0u && segment == 0u;
                 causticSpeculars = 0u;
                 scatteredOnVolumeSegment = volumeSegment;
-                if (!survives(throughput, bounce, rng)) alive = false;
+                if (!last && !survives(throughput, etaScale, bounce, rng)) alive = false;
                 ++bounce;
                 continue;
             }
@@ -502,6 +578,27 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             // sphere or rect light is the volume pass's.
             bool coveredByVolume = afterVolumeScatter && which != frame.lightCount;
             if (!coveredByCaustics && !coveredByVolume) radiance += throughput * le * w;
+            record(EVENT_EMITTER, which == frame.lightCount ? NO_HIT : which, NO_TEXTURE,
+                   which == frame.lightCount ? NO_HIT : lights[which].kind, tl, 0.0, 0.0, w, o + min(tl, 1e30) * d,
+                   throughput * le * w, throughput, radiance);
+            alive = false;
+            continue;
+        }
+        if (emitterOnly) {
+            // The last vertex's continuation: only a surface's emission
+            // counts (emissive surfaces are found by BSDF sampling alone);
+            // an index-matched interface is passed straight on.
+            uint mi = objects[h.object].material;
+            Material m = materials[mi];
+            bool entering = dot(d, h.normal) < 0.0;
+            if (m.kind == MATERIAL_DIELECTRIC && abs(m.ior / farSideIor(media, mi, entering) - 1.0) < 1e-6) {
+                crossInterface(media, mi, entering);
+                o = offsetOrigin(o + h.t * d, h.normal, d, h.offset);
+                continue;
+            }
+            radiance += throughput * v3(m.emission);
+            record(EVENT_EMITTER, h.object, mi, NO_HIT, h.t, 0.0, 0.0, 1.0, o + h.t * d, throughput * v3(m.emission),
+                   throughput, radiance);
             alive = false;
             continue;
         }
@@ -532,12 +629,20 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             if (abs(mat.ior - 1.0) < 1e-6) {
                 // Invisible interface: continue straight on, into or out of this medium.
                 crossInterface(media, matIndex, entering);
+                record(EVENT_PASS_THROUGH, h.object, matIndex, entering ? LOBE_TRANSMIT : LOBE_REFLECT, h.t, 0.0, 0.0,
+                       0.0, o + h.t * d, vec3(1.0), throughput, radiance);
                 o = offsetOrigin(o + h.t * d, h.normal, d, h.offset);
                 continue;
             }
         }
         vec3 p = o + h.t * d;
         radiance += throughput * v3(mat.emission);
+        // A dielectric's shading normal must agree with the geometric one on
+        // which side the ray comes from (the media stack follows the
+        // geometric side, the refraction's η the shading side); where a
+        // normal or bump map tilts it past the ray, the geometric normal
+        // shades this vertex.
+        if (mat.kind == MATERIAL_DIELECTRIC && (dot(ns, d) < 0.0) != entering) ns = h.normal;
         // Two-sided shading; dielectrics keep the outward normal to tell inside from outside.
         vec3 n = mat.kind == MATERIAL_DIELECTRIC || dot(h.normal, d) < 0.0 ? ns : -ns;
         mat3 frameW = frameAround(n);
@@ -547,19 +652,34 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             && receivers[pixel].object == h.object;
         if (primaryReceiver) radiance += throughput * v3(mat.albedo) / PI * FIXED_POINT_RGB(causticMap, pixel);
         if (!isDelta(mat)) {
-            vec3 c = nextEvent(mat, frameW, wo, p, h.normal, h.offset, med, !last, rng, sr);
+            vec3 c = nextEvent(mat, frameW, wo, d, p, h.normal, h.offset, med, rng, sr);
             queueShadowRay(sr, throughput * c);
-        }
-        if (last) {
-            alive = false;
-            continue;
         }
 
         BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
         if (!bs.valid) {
+            record(EVENT_SURFACE, h.object, matIndex, LOBE_INVALID, h.t, wo.z, bs.wi.z, bs.pdf, p, bs.weight, throughput,
+                   radiance);
             alive = false;
             continue;
         }
+        vec3 next = normalize(frameW * bs.wi);
+        // The sampled direction must leave on the side of the geometric
+        // surface that its lobe belongs to (reflection: the side it came
+        // from; transmission: the other). A shading normal (normal and bump
+        // maps), or f32 rounding of a grazing direction, can put it on the
+        // other side; such a ray would start on the wrong side of the
+        // surface (offsetOrigin follows the geometric normal) with the media
+        // stack unchanged, and leave glass it never entered with an η² gain.
+        // The path ends there instead.
+        if ((dot(next, h.normal) * dot(d, h.normal) > 0.0) != (bs.wi.z * wo.z < 0.0)) {
+            record(EVENT_SURFACE, h.object, matIndex, LOBE_INVALID, h.t, wo.z, bs.wi.z, bs.pdf, p, bs.weight, throughput,
+                   radiance);
+            alive = false;
+            continue;
+        }
+        record(EVENT_SURFACE, h.object, matIndex, bs.wi.z * wo.z < 0.0 ? LOBE_TRANSMIT : LOBE_REFLECT, h.t, wo.z,
+               bs.wi.z, bs.pdf, p, bs.weight, throughput * bs.weight, radiance);
         if (CAUSTICS_ENABLED != 0u) {
             // The caustic rays pass dielectrics by refraction (reflection
             // only under total internal reflection) and reflect off mirrors
@@ -574,7 +694,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 causticPath = false;
             }
         }
-        if (FILTER_MODE != FILTER_NONE) {
+        if (FILTER_MODE != FILTER_NONE && !last) {
             // The outgoing footprint: the normal facing the incoming ray tilts
             // by S u at surface offset u (S: its shape operator, exact from
             // the Hessian of F'), which turns the outgoing direction by the
@@ -610,16 +730,21 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 coneWidth = width;
             }
         }
-        // Transmitted: update the stack of media.
-        if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) crossInterface(media, matIndex, entering);
+        // Transmitted: update the stack of media, and the η² factor the
+        // weight divided the throughput by (mat.ior is n_inside / n_outside).
+        if (mat.kind == MATERIAL_DIELECTRIC && bs.wi.z * wo.z < 0.0) {
+            crossInterface(media, matIndex, entering);
+            float etaRel = wo.z > 0.0 ? mat.ior : 1.0 / mat.ior;
+            etaScale *= etaRel * etaRel;
+        }
         throughput *= bs.weight;
         lastPdf = bs.pdf;
         scatterDensity = 0.0;
         lastPoint = p;
-        d = normalize(frameW * bs.wi);
+        d = next;
         o = offsetOrigin(p, h.normal, d, h.offset);
 
-        if (!survives(throughput, bounce, rng)) alive = false;
+        if (!last && !survives(throughput, etaScale, bounce, rng)) alive = false;
         ++bounce;
     }
     return radiance;
@@ -644,6 +769,7 @@ void main() {
         float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * 0.28867513;
         vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, coneFootprint(d, h.normal, sigma), ns).albedo);
         aov.albedo = float[3](alb.x, alb.y, alb.z);
+        aov.object = h.object;
         aovs[idx] = aov;
     }
 
@@ -654,4 +780,8 @@ void main() {
     bool finite = !any(isnan(radiance)) && !any(isinf(radiance));
     ivec2 at = ivec2(pix);
     imageStore(accum, at, imageLoad(accum, at) + (finite ? vec4(radiance, 1.0) : vec4(0.0)));
+    float luminance = finite ? dot(radiance, vec3(0.2126, 0.7152, 0.0722)) : 0.0;
+    vec2 largest = imageLoad(maxSample, at).rg;
+    if (luminance > largest.r) imageStore(maxSample, at, vec4(luminance, float(pc.sampleIndex), 0.0, 0.0));
+    record(EVENT_END, NO_HIT, NO_TEXTURE, finite ? 0u : 1u, 0.0, 0.0, 0.0, 0.0, vec3(0.0), vec3(0.0), vec3(0.0), radiance);
 }

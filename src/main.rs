@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use quadray::output::{write_outputs, ExrPrecision, OutputKind};
+use quadray::output::{write_exr, write_outputs, ExrPrecision, OutputKind};
 use quadray::progress::ProgressBar;
 use quadray::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
@@ -36,6 +36,11 @@ enum Command {
     /// relative MSE against GPU time per pass); writes bench.json, bench.md,
     /// bench.png (error against time) and the renders.
     Bench(BenchArgs),
+    /// Find samples that gain energy: render a scene by brute force, report
+    /// the pixels whose largest single sample exceeds the bound the scene's
+    /// emitters allow, and print the path of the worst ones, event by event.
+    /// Exits with status 3 when any pixel exceeds the bound.
+    Outliers(OutliersArgs),
     /// Compare a render with a reference: FLIP (mean, from nv-flip) and
     /// relative MSE between two EXR files of the same size.
     Compare(CompareArgs),
@@ -172,6 +177,45 @@ enum BenchShading {
     Full,
     /// The albedo seen directly and through perfect mirrors, no lighting.
     Albedo,
+}
+
+#[derive(Parser, Debug)]
+struct OutliersArgs {
+    /// Scene file (TOML). Omit it to check the built-in default scene.
+    scene: Option<PathBuf>,
+    /// Image width in pixels (overrides `image.width`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Image height in pixels (overrides `image.height`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Random seed (overrides `image.seed`).
+    #[arg(long)]
+    seed: Option<u32>,
+    #[command(flatten)]
+    quality: QualityArgs,
+    /// The bound on a sample's luminance (default: the one the scene's
+    /// emitters and depth allow; needed for scenes with point or
+    /// directional lights).
+    #[arg(long)]
+    bound: Option<f32>,
+    /// How many of the worst pixels to trace and print.
+    #[arg(long, default_value_t = 3)]
+    worst: usize,
+    /// Write the largest-sample AOV (luminance, sample index) and the
+    /// radiance to this EXR.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Also render a reference with this many samples per pixel (another
+    /// seed) and print the relative MSE of the whole image and of each
+    /// region (the pixels that see one object, silhouettes left out): a
+    /// whole-image error far above the mean of the regions' says that a few
+    /// pixels dominate it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    regions: Option<u32>,
+    /// Enable the Khronos validation layer; the command fails if it reports errors.
+    #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
+    validation: bool,
 }
 
 #[derive(Parser, Debug, Default)]
@@ -393,6 +437,115 @@ fn render(args: RenderArgs) -> Result<()> {
     drop(ctx);
     if counters.errors() > 0 {
         bail!("the validation layer reported {} error(s) at shutdown", counters.errors());
+    }
+    Ok(())
+}
+
+/// `quadray outliers`: samples over the scene's bound, and their paths.
+fn outliers(args: OutliersArgs) -> Result<()> {
+    use quadray::passes::outliers::{describe_path, largest_sample, outliers, SampleBound};
+    use quadray::passes::{GpuScene, RenderVariant, Renderer};
+    let render_args = RenderArgs {
+        scene: args.scene.clone(),
+        width: args.width,
+        height: args.height,
+        seed: args.seed,
+        quality: args.quality.clone(),
+        ..Default::default()
+    };
+    let scene = load(&render_args)?;
+    let bound = match args.bound {
+        Some(b) => b,
+        None => {
+            let b = SampleBound::of(&scene).context("give the bound with --bound")?;
+            eprintln!(
+                "bound: {:.4} = largest emitted luminance {:.4} x (1 + 1.5 x {} bounces)",
+                b.luminance, b.emitted, b.max_depth
+            );
+            b.luminance
+        }
+    };
+    let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
+    let counters = ctx.counters();
+    let device = &ctx.device;
+    let mut cmds = quadray::vk::Commands::new(device)?;
+    let gpu = GpuScene::with_origin(
+        device,
+        &mut cmds,
+        &scene,
+        &quadray::geometry::CellParams::default(),
+        scene.camera.position,
+    )?;
+    let im = &scene.image;
+    let variant = RenderVariant { filter: im.filter.constant(), caustics: false, volume: false, ..Default::default() };
+    let mut progress = ProgressBar::new(false);
+    let out = quadray::passes::render(
+        device,
+        &mut cmds,
+        &gpu,
+        &scene,
+        (im.width, im.height, im.spp),
+        variant,
+        &mut |d, t| progress.update(d, t),
+    )?;
+    progress.finish();
+    let samples = out.width as u64 * out.height as u64 * out.spp as u64;
+    let found = outliers(&out, bound);
+    if let Some(m) = largest_sample(&out) {
+        eprintln!(
+            "{samples} samples ({}x{}, {} spp, seed {}): largest sample {:.4} at pixel ({}, {}), sample {}",
+            out.width, out.height, out.spp, im.seed, m.luminance, m.x, m.y, m.sample
+        );
+    }
+    println!("{} pixel(s) with a sample over the bound {bound:.4}", found.len());
+    for o in found.iter().take(20) {
+        println!("  pixel ({}, {}): sample {} of luminance {:.4}", o.x, o.y, o.sample, o.luminance);
+    }
+    if !found.is_empty() && args.worst > 0 {
+        let record = RenderVariant { record_path: true, ..variant };
+        let mut recorder = Renderer::new(device, &mut cmds, &gpu, &scene, (im.width, im.height, 1), record)?;
+        for o in found.iter().take(args.worst) {
+            let path = recorder.trace_path(&mut cmds, (o.x, o.y), o.sample)?;
+            println!("\npixel ({}, {}), sample {} (luminance {:.4}):", o.x, o.y, o.sample, o.luminance);
+            print!("{}", describe_path(&scene, &path));
+        }
+    }
+    if let Some(path) = &args.output {
+        write_exr(&out, ExrPrecision::Float, path)?;
+    }
+    if let Some(reference_spp) = args.regions {
+        let mut reference_scene = scene.clone();
+        reference_scene.image.seed = scene.image.seed ^ 0x9e37_79b9;
+        let mut progress = ProgressBar::new(false);
+        let reference = quadray::passes::render(
+            device,
+            &mut cmds,
+            &gpu,
+            &reference_scene,
+            (im.width, im.height, reference_spp),
+            variant,
+            &mut |d, t| progress.update(d, t),
+        )?;
+        progress.finish();
+        let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+        let e = quadray::metrics::region_relative_mse(&reference, &out, 2, 64)?;
+        println!("\nrelative MSE at {} spp against {reference_spp} spp:", out.spp);
+        for (object, pixels, error) in &e.regions {
+            let name = names.get(*object as usize).copied().unwrap_or("background");
+            println!("  {name:<24} {pixels:>7} pixels  {error:.5}");
+        }
+        println!(
+            "  whole image {:.5}, mean of the regions {:.5}: ratio {:.3}",
+            e.whole,
+            e.mean_of_regions(),
+            e.ratio()
+        );
+    }
+    if counters.errors() > 0 {
+        bail!("the validation layer reported {} error(s)", counters.errors());
+    }
+    if !found.is_empty() {
+        std::process::exit(3);
     }
     Ok(())
 }
@@ -687,6 +840,7 @@ fn main() -> Result<()> {
         Some(Command::Render(args)) => render(args),
         Some(Command::FilterBench(args)) => filter_bench(args),
         Some(Command::Compare(args)) => compare(args),
+        Some(Command::Outliers(args)) => outliers(args),
         Some(Command::Bench(args)) => bench_presets(args),
         Some(Command::View(args)) => view(args),
         None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),

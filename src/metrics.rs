@@ -65,6 +65,84 @@ pub fn relative_mse(reference: &RenderOutput, test: &RenderOutput) -> Result<f64
     Ok(sum / (3 * reference.radiance.len()) as f64)
 }
 
+/// Relative MSE over the whole image and over its regions: the pixels that
+/// see one object (or the background), by the reference's `object` AOV,
+/// less those within `margin` pixels of another region (silhouettes). When
+/// a handful of pixels dominate the error (outlier samples at silhouettes,
+/// say) the whole image's error is far above the mean of the regions'; with
+/// error spread evenly the two are close.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegionErrors {
+    /// Relative MSE of the whole image.
+    pub whole: f64,
+    /// Per region: the object index (`NO_HIT` for the background), its
+    /// pixel count and its relative MSE.
+    pub regions: Vec<(u32, usize, f64)>,
+}
+
+impl RegionErrors {
+    /// The mean of the regions' relative MSEs (each region counted once).
+    pub fn mean_of_regions(&self) -> f64 {
+        self.regions.iter().map(|r| r.2).sum::<f64>() / self.regions.len().max(1) as f64
+    }
+
+    /// The whole image's error over the mean of the regions'.
+    pub fn ratio(&self) -> f64 {
+        self.whole / self.mean_of_regions()
+    }
+}
+
+/// [`RegionErrors`] of `test` against `reference`, whose AOVs define the
+/// regions; regions of fewer than `min_pixels` pixels are left out of the
+/// mean (their error is noise).
+pub fn region_relative_mse(
+    reference: &RenderOutput,
+    test: &RenderOutput,
+    margin: u32,
+    min_pixels: usize,
+) -> Result<RegionErrors, MetricError> {
+    check_sizes(reference, test)?;
+    if reference.aov.len() != reference.radiance.len() {
+        return Err(MetricError::Empty);
+    }
+    let (w, h) = (reference.width as i64, reference.height as i64);
+    let m = margin as i64;
+    let pixel_error = |i: usize| -> f64 {
+        let (r, t) = (reference.radiance[i], test.radiance[i]);
+        (0..3)
+            .map(|c| {
+                let (r, t) = (f64::from(r[c]), f64::from(t[c]));
+                (t - r) * (t - r) / (r * r + RELATIVE_MSE_EPSILON)
+            })
+            .sum::<f64>()
+            / 3.0
+    };
+    let mut sums: std::collections::BTreeMap<u32, (usize, f64)> = Default::default();
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let object = reference.aov[i].object;
+            let interior = (-m..=m).all(|dy| {
+                (-m..=m).all(|dx| {
+                    let (xx, yy) = (x + dx, y + dy);
+                    xx >= 0 && yy >= 0 && xx < w && yy < h && reference.aov[(yy * w + xx) as usize].object == object
+                })
+            });
+            if interior {
+                let e = sums.entry(object).or_default();
+                e.0 += 1;
+                e.1 += pixel_error(i);
+            }
+        }
+    }
+    let regions = sums
+        .into_iter()
+        .filter(|(_, (n, _))| *n >= min_pixels.max(1))
+        .map(|(o, (n, e))| (o, n, e / n as f64))
+        .collect();
+    Ok(RegionErrors { whole: relative_mse(reference, test)?, regions })
+}
+
 /// Mean absolute difference of the tone-mapped images (values in [0, 1]
 /// per channel): the frame-to-frame change of an animation as a viewer sees it.
 pub fn mean_display_change(a: &RenderOutput, b: &RenderOutput, exposure: f32) -> Result<f64, MetricError> {

@@ -22,6 +22,11 @@ pub enum ExrPrecision {
 pub const EXR_CHANNELS: [&str; 10] =
     ["R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G", "albedo.B"];
 
+/// The largest-sample AOV's EXR channels, written when the render has it:
+/// the luminance of the pixel's largest single sample and that sample's
+/// index.
+pub const EXR_MAX_SAMPLE_CHANNELS: [&str; 2] = ["max_sample.Y", "max_sample.index"];
+
 /// What to write to one output file.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum OutputKind {
@@ -115,7 +120,10 @@ fn write_png_to(out: &RenderOutput, exposure: f32, path: &Path) -> io::Result<()
 
 /// Writes the linear EXR (not atomically): RGB radiance and the AOVs `depth`
 /// (distance along the normalised pixel-centre ray, +inf on a miss),
-/// `normal.XYZ` (world space, zero on a miss) and `albedo.RGB`.
+/// `normal.XYZ` (world space, zero on a miss) and `albedo.RGB`, and, when
+/// the render has it, the largest-sample AOV `max_sample.Y` (the luminance of
+/// the pixel's largest single sample) and `max_sample.index` (which sample
+/// it was; always 32-bit).
 pub fn write_exr_to(out: &RenderOutput, precision: ExrPrecision, path: &Path) -> io::Result<()> {
     let columns: [Vec<f32>; 10] = [
         out.radiance.iter().map(|p| p[0]).collect(),
@@ -129,7 +137,7 @@ pub fn write_exr_to(out: &RenderOutput, precision: ExrPrecision, path: &Path) ->
         out.aov.iter().map(|a| a.albedo[1]).collect(),
         out.aov.iter().map(|a| a.albedo[2]).collect(),
     ];
-    let channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = EXR_CHANNELS
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = EXR_CHANNELS
         .iter()
         .zip(columns)
         .map(|(name, values)| {
@@ -140,6 +148,11 @@ pub fn write_exr_to(out: &RenderOutput, precision: ExrPrecision, path: &Path) ->
             AnyChannel::new(*name, samples)
         })
         .collect();
+    if !out.max_sample.is_empty() {
+        let [y, index] = EXR_MAX_SAMPLE_CHANNELS;
+        channels.push(AnyChannel::new(y, FlatSamples::F32(out.max_sample.iter().map(|m| m[0]).collect())));
+        channels.push(AnyChannel::new(index, FlatSamples::F32(out.max_sample.iter().map(|m| m[1]).collect())));
+    }
     let image = Image::from_channels((out.width as usize, out.height as usize), AnyChannels::sort(channels));
     image.write().to_file(path).map_err(io::Error::other)
 }

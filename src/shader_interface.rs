@@ -122,3 +122,34 @@ pub const BINDING_RENDER_BEAMS: u32 = 15;
 /// coarser cells than surface caustics: a beam's cost grows with its size
 /// on screen).
 pub const BEAM_STRIDE: u32 = 8;
+/// Descriptor binding of the largest single sample per pixel (render pass):
+/// its luminance and the sample index that brought it.
+pub const BINDING_RENDER_MAX_SAMPLE: u32 = 16;
+/// Descriptor binding of the recorded path vertices (render pass, when
+/// specialised to record one pixel's path).
+pub const BINDING_RENDER_PATH: u32 = 17;
+/// Vertices a recorded path holds at most.
+pub const PATH_RECORD_VERTICES: u32 = 96;
+/// Recorded path event: a surface scattering (a BSDF sample).
+pub const EVENT_SURFACE: u32 = 0;
+/// Recorded path event: an emitter found by the path (a light, the
+/// environment, or an emissive surface), with its MIS weight.
+pub const EVENT_EMITTER: u32 = 1;
+/// Recorded path event: next-event estimation queued a shadow ray.
+pub const EVENT_LIGHT_SAMPLE: u32 = 2;
+/// Recorded path event: a queued shadow ray's result (pdf 1: unblocked).
+pub const EVENT_SHADOW: u32 = 3;
+/// Recorded path event: a scattering event in a medium.
+pub const EVENT_MEDIUM: u32 = 4;
+/// Recorded path event: an index-matched interface crossed straight on.
+pub const EVENT_PASS_THROUGH: u32 = 5;
+/// Recorded path event: the path ended (lobe: why; see `PATH_END_*`).
+pub const EVENT_END: u32 = 6;
+/// Recorded path event: Russian roulette survived (pdf: the survival probability).
+pub const EVENT_ROULETTE: u32 = 7;
+/// Recorded lobe: reflection.
+pub const LOBE_REFLECT: u32 = 0;
+/// Recorded lobe: transmission.
+pub const LOBE_TRANSMIT: u32 = 1;
+/// Recorded lobe: invalid sample (the path ends).
+pub const LOBE_INVALID: u32 = 2;

@@ -236,12 +236,20 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     let exr = Exr::read(&outdir.path().join("out.exr"));
     assert_eq!(exr.size(), (WIDTH, HEIGHT));
     let mut want = quadray::output::EXR_CHANNELS.map(String::from).to_vec();
+    want.extend(quadray::output::EXR_MAX_SAMPLE_CHANNELS.map(String::from));
     want.sort();
     assert_eq!(exr.names(), want);
-    for name in quadray::output::EXR_CHANNELS {
+    for name in quadray::output::EXR_CHANNELS.iter().chain(&quadray::output::EXR_MAX_SAMPLE_CHANNELS) {
         assert!(matches!(exr.samples(name), FlatSamples::F32(_)), "{name} should hold 32-bit floats");
     }
     let depth = exr.channel("depth");
+    // The largest-sample AOV: between the pixel's mean luminance and spp
+    // times it (samples are never negative), a whole sample index below
+    // spp; on pixels that see only the background every sample is the
+    // background.
+    let spp = 25656.0;
+    let (largest, index) = (exr.channel("max_sample.Y"), exr.channel("max_sample.index"));
+    let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
     let normal = exr.vec3(["normal.X", "normal.Y", "normal.Z"]);
     let albedo = exr.vec3(["albedo.R", "albedo.G", "albedo.B"]);
     let rgb = exr.vec3(["R", "G", "B"]);
@@ -260,6 +268,13 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
             let i = y * WIDTH + x;
             let at = format!("pixel ({x}, {y})");
             assert!(rgb[i].iter().all(|v| v.is_finite() && *v >= 0.0), "{at}: radiance {:?}", rgb[i]);
+            let mean = luminance(rgb[i]);
+            assert!(
+                largest[i] >= mean * (1.0 - 1e-4) && largest[i] <= spp * mean * (1.0 + 1e-4),
+                "{at}: largest sample {}",
+                largest[i]
+            );
+            assert!(index[i] >= 0.0 && index[i] < spp && index[i].fract() == 0.0, "{at}: sample {}", index[i]);
             let e = expected(x, y, WIDTH, HEIGHT);
             if (e.miss_distance - 1.0).abs() < 1e-3 {
                 continue; // grazing: either answer is right
@@ -271,6 +286,12 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                     assert_eq!(normal[i], [0.0; 3], "{at}: normal of a miss");
                     assert_eq!(albedo[i], [0.0; 3], "{at}: albedo of a miss");
                     if e.miss_distance > 1.0 + 1.5 * pixel {
+                        let b = luminance(BACKGROUND);
+                        assert!(
+                            (largest[i] - b).abs() < 1e-6,
+                            "{at}: largest sample {} of the background {b}",
+                            largest[i]
+                        );
                         for k in 0..3 {
                             // f32 accumulation of 256 samples rounds at ~1e-4 relative.
                             assert!((rgb[i][k] - BACKGROUND[k]).abs() < 2e-4, "{at}: background {:?}", rgb[i]);
@@ -364,6 +385,10 @@ fn half_exr_only_with_size_overrides_and_validation_from_the_environment() {
     assert_eq!(exr.size(), (w, h));
     for name in quadray::output::EXR_CHANNELS {
         assert!(matches!(exr.samples(name), FlatSamples::F16(_)), "{name} should hold half floats");
+    }
+    // Sample indices need more than f16's 11 bits: these stay 32-bit.
+    for name in quadray::output::EXR_MAX_SAMPLE_CHANNELS {
+        assert!(matches!(exr.samples(name), FlatSamples::F32(_)), "{name} should hold 32-bit floats");
     }
     let depth = exr.channel("depth");
     assert_eq!(depth[0], f32::INFINITY, "corner pixel misses");

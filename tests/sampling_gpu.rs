@@ -266,6 +266,144 @@ fn gpu_bsdf_sampling_matches_the_cpu_twin() {
     assert!(share <= MAX_EDGE_SHARE, "too many edge cases: {share}");
 }
 
+/// A direction at angle θ with cos θ = `z` (signed) from the normal, at a
+/// random azimuth.
+fn dir_with_z(rng: &mut Pcg64, z: f64) -> DVec3 {
+    let phi = rng.gen_range(0.0..std::f64::consts::TAU);
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Every sampled weight on the GPU is at most its bound, at every angle and
+/// for every random number, with nothing set aside: grazing directions down
+/// to cos θ = 1e-7, visible normals with u1 one f32 step below 1, the
+/// dielectrics' lobe choice at u3 = F ± 1e-7, and random inputs. The bound:
+/// the albedo for diffuse and mirror lobes, 1 for conductors (Fresnel ≤ 1)
+/// and dielectric reflection, 1/η² for refraction (the radiance scaling
+/// across an interface; η = n_t / n_i): `weight · η²` ≤ 1. The GLSL writes
+/// the visible-normal weight G2/G1 as one quotient (bsdf.glsl,
+/// ggxG2OverG1) so that it cannot round above 1; the only slack in the check
+/// is the f32 rounding of η² that the GPU divides by (2⁻²¹ relative).
+///
+/// Light sampling's bound (src/passes/outliers.rs) also needs
+/// f(wo, wi) |cos θi| / pdf(wo, wi) ≤ the same bound for directions the
+/// BSDF did not choose: checked on random and grazing pairs. There f and
+/// the pdf are rounded apart (D(m) appears in both), so the check allows
+/// 1e-5 relative: far below the bound's own slack.
+#[test]
+fn gpu_bsdf_weights_never_exceed_their_bound() {
+    const ROUNDING: f64 = 1.0 / (1 << 21) as f64;
+    const EVAL_ROUNDING: f64 = 1e-5;
+    let mut rng = Pcg64::seed_from_u64(14);
+    let materials = random_materials();
+    let grazing = [1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.1];
+    let rims = [1.0 - f32::EPSILON as f64 / 2.0, 1.0 - 1e-6, 1.0 - 1e-4, 0.0];
+    let mut cases = Vec::new();
+    let mut inputs = Vec::new();
+    for m in &materials {
+        let dielectric = matches!(m.kind, MaterialKind::Dielectric { .. });
+        let mut push = |wo: DVec3, wi: DVec3, u: [f64; 3]| {
+            let (wo, wi) = (d3(f3(wo)), d3(f3(wi)));
+            let u = u.map(|v| (v as f32).min(1.0 - f32::EPSILON / 2.0));
+            cases.push(TwinCase {
+                op: 0,
+                mat: GpuMaterial::from(m),
+                light: GpuLight::default(),
+                wo: f3(wo),
+                wi: f3(wi),
+                u,
+                x: [0.0; 3],
+            });
+            inputs.push((m.clone(), wo, wi));
+        };
+        for _ in 0..300 {
+            // Random directions and numbers.
+            let wo = random_dir(&mut rng, !dielectric);
+            let wi = random_dir(&mut rng, !dielectric);
+            push(wo, wi, [rng.gen(), rng.gen(), rng.gen()]);
+            for &z in &grazing {
+                let sides: &[f64] = if dielectric { &[1.0, -1.0] } else { &[1.0] };
+                for &side in sides {
+                    let wo = dir_with_z(&mut rng, side * z);
+                    // wi grazing too, on either side, and random.
+                    let zi = if rng.gen() { z } else { -z };
+                    let wi = dir_with_z(&mut rng, zi);
+                    push(wo, wi, [rng.gen(), rng.gen(), rng.gen()]);
+                    push(wo, random_dir(&mut rng, !dielectric), [rng.gen(), rng.gen(), rng.gen()]);
+                    let u1 = rims[rng.gen_range(0..rims.len())];
+                    push(wo, wi, [u1, rng.gen(), rng.gen()]);
+                    // The lobe choice right at F (smooth: F at wo.z).
+                    if let MaterialKind::Dielectric { ior, .. } = m.kind {
+                        let f = sampling::fresnel_dielectric(d3(f3(wo)).z, ior as f64);
+                        let e = if rng.gen() { 1e-7 } else { -1e-7 };
+                        push(wo, wi, [rng.gen(), rng.gen(), (f + e).clamp(0.0, 1.0)]);
+                    }
+                }
+            }
+        }
+    }
+    let results = run_twins(&cases);
+    let (mut samples, mut pairs, mut worst_sample, mut worst_pair) = (0usize, 0usize, 0f64, 0f64);
+    let mut failures = Vec::new();
+    for ((m, wo, wi), r) in inputs.iter().zip(&results) {
+        let bound = match m.kind {
+            MaterialKind::Diffuse | MaterialKind::Mirror => m.albedo.as_dvec3(),
+            _ => DVec3::ONE,
+        };
+        let eta_rel = match m.kind {
+            MaterialKind::Dielectric { ior, .. } => {
+                if wo.z > 0.0 {
+                    ior as f64
+                } else {
+                    1.0 / ior as f64
+                }
+            }
+            _ => 1.0,
+        };
+        let values =
+            d3(r.weight).to_array().into_iter().chain(d3(r.eval).to_array()).chain([r.pdf as f64, r.pdf_of as f64]);
+        if values.clone().any(|v| !v.is_finite() || v < 0.0) {
+            failures.push(format!("{}: non-finite or negative output at wo={wo:?}: {r:?}", m.name));
+            continue;
+        }
+        if r.valid != 0 {
+            samples += 1;
+            let transmitted = r.wi[2] as f64 * wo.z < 0.0;
+            let scale = if transmitted { eta_rel * eta_rel } else { 1.0 };
+            let ratio = (d3(r.weight) * scale / bound).max_element();
+            worst_sample = worst_sample.max(ratio);
+            if ratio > 1.0 + ROUNDING {
+                failures.push(format!(
+                    "{}: sampled weight {:?} x {scale} over {bound:?} at wo={wo:?}: {r:?}",
+                    m.name, r.weight
+                ));
+            }
+        }
+        if r.pdf_of > 0.0 {
+            pairs += 1;
+            let transmitted = wi.z * wo.z < 0.0;
+            let scale = if transmitted { eta_rel * eta_rel } else { 1.0 };
+            let ratio = (d3(r.eval) * wi.z.abs() * scale / r.pdf_of as f64 / bound).max_element();
+            worst_pair = worst_pair.max(ratio);
+            if ratio > 1.0 + EVAL_ROUNDING {
+                failures.push(format!("{}: f cos / pdf = {ratio} of the bound at wo={wo:?} wi={wi:?}: {r:?}", m.name));
+            }
+        }
+    }
+    println!(
+        "BSDF weight bounds: {} cases ({} materials), nothing set aside: {samples} samples, largest weight {worst_sample:.9} \
+         of its bound (allowed 1 + {ROUNDING:.1e}); {pairs} evaluated pairs, largest f cos / pdf {worst_pair:.9} of \
+         the bound (allowed 1 + {EVAL_ROUNDING:e})",
+        inputs.len(),
+        materials.len()
+    );
+    for f in failures.iter().take(8) {
+        println!("  {f}");
+    }
+    assert!(failures.is_empty(), "{} weights over their bound", failures.len());
+    assert!(samples > 100_000, "too few valid samples: {samples}");
+}
+
 #[test]
 fn gpu_light_sampling_matches_the_cpu_twin() {
     let mut rng = Pcg64::seed_from_u64(9);

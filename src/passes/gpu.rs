@@ -338,6 +338,44 @@ pub struct GpuAov {
     pub normal: [f32; 3],
     /// Material albedo (zero on a miss).
     pub albedo: [f32; 3],
+    /// Index of the object hit (`NO_HIT` on a miss).
+    pub object: u32,
+}
+
+/// `PathVertex` in render.comp: one event of a recorded path (the outlier
+/// report's). The fields' meanings depend on `event` (an `EVENT_*`
+/// constant); render.comp documents each.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuPathVertex {
+    /// `EVENT_*`.
+    pub event: u32,
+    /// Object index, or the light index for emitters and light samples
+    /// (`NO_HIT`: the environment or none).
+    pub object: u32,
+    /// Material index (`NO_TEXTURE` when none).
+    pub material: u32,
+    /// `LOBE_*` for surface events, the light kind for emitters and light
+    /// samples, 1/0 for shadow rays (unblocked/blocked), 1 for a non-finite
+    /// end.
+    pub lobe: u32,
+    /// Ray parameter of the hit, or the shadow ray's or light's distance.
+    pub t: f32,
+    /// Cosine of wo with the shading normal (signed).
+    pub cos_o: f32,
+    /// Cosine of wi with the shading normal (signed).
+    pub cos_i: f32,
+    /// Solid-angle pdf of the sample (0: delta lobe), the MIS weight for
+    /// emitters, the survival probability for Russian roulette.
+    pub pdf: f32,
+    /// Where (in the GPU frame, relative to the camera).
+    pub position: [f32; 3],
+    /// The sample's weight, or the contribution an emitter or shadow ray brings.
+    pub weight: [f32; 3],
+    /// The path throughput after the event.
+    pub throughput: [f32; 3],
+    /// The sample's radiance so far.
+    pub radiance: [f32; 3],
 }
 
 /// `Ray` in probe.comp.
@@ -499,10 +537,11 @@ const _: () = {
     assert!(std::mem::size_of::<GpuMedium>() == 20);
     assert!(std::mem::size_of::<GpuLight>() == 56);
     assert!(std::mem::size_of::<GpuFrame>() == 116);
-    assert!(std::mem::size_of::<GpuAov>() == 28);
+    assert!(std::mem::size_of::<GpuAov>() == 32);
     assert!(std::mem::size_of::<GpuRay>() == 32);
     assert!(std::mem::size_of::<GpuHit>() == 32);
     assert!(std::mem::size_of::<RenderPush>() == 24);
+    assert!(std::mem::size_of::<GpuPathVertex>() == 80);
     assert!(std::mem::size_of::<ProbePush>() == 8);
     assert!(std::mem::size_of::<GpuTexQuery>() == 32);
     assert!(std::mem::size_of::<GpuTexResult>() == 32);

@@ -3,6 +3,7 @@
 
 pub mod caustics;
 pub mod gpu;
+pub mod outliers;
 pub mod probe;
 pub mod render;
 pub mod scene_gpu;

@@ -5,11 +5,13 @@
 use std::sync::Arc;
 
 use super::caustics::{emitters, CausticMap, CausticReport};
-use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, RenderPush};
+use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::volume::VolumeLight;
 use crate::scene::Scene;
-use crate::shader_interface::{FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, RENDER_GROUP, SHADING_FULL};
+use crate::shader_interface::{
+    FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP, SHADING_FULL,
+};
 use crate::vk::{
     full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
 };
@@ -42,6 +44,11 @@ pub struct RenderOutput {
     /// Samples whose radiance came out NaN or infinite, counted as black
     /// (0 in every test; the CLI warns otherwise).
     pub dropped_samples: u64,
+    /// The largest single sample per pixel: its luminance (Rec. 709 Y of
+    /// the sample's linear radiance) and the sample index that brought it
+    /// (empty for an image read from a file). The outlier report compares it
+    /// with the bound the scene allows (`passes::outliers`).
+    pub max_sample: Vec<[f32; 2]>,
 }
 
 impl RenderOutput {
@@ -58,6 +65,7 @@ impl RenderOutput {
             caustics: None,
             volume_seconds: None,
             dropped_samples: 0,
+            max_sample: vec![],
         }
     }
 }
@@ -83,11 +91,21 @@ pub struct RenderVariant {
     /// Run the volume pass when the scene needs it (false: the path tracer
     /// alone estimates the light scattered by the fog).
     pub volume: bool,
+    /// Record the events of one pixel's path ([`Renderer::trace_path`]);
+    /// false compiles the recording out.
+    pub record_path: bool,
 }
 
 impl Default for RenderVariant {
     fn default() -> Self {
-        Self { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter: FILTER_NONE, caustics: true, volume: true }
+        Self {
+            intersect: INTERSECT_FULL,
+            shading: SHADING_FULL,
+            filter: FILTER_NONE,
+            caustics: true,
+            volume: true,
+            record_path: false,
+        }
     }
 }
 
@@ -153,7 +171,9 @@ pub struct Renderer {
     // Bound in place of the outputs of passes that do not run; only held.
     _placeholder: Buffer,
     accum: Image,
+    max_sample: Image,
     readback: Buffer,
+    path: Buffer,
     aov: Buffer,
     timer: GpuTimer,
     tiles: Vec<[u32; 4]>,
@@ -198,6 +218,14 @@ impl Renderer {
             vk::Format::R32G32B32A32_SFLOAT,
             vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
         )?;
+        let max_sample = Image::new(
+            device,
+            "largest sample",
+            vk::Extent2D { width, height },
+            vk::Format::R32G32_SFLOAT,
+            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
+        )?;
+        // Holds the accumulation, then the largest samples (half its size).
         let readback = Buffer::new(
             device,
             "accumulation readback",
@@ -209,6 +237,16 @@ impl Renderer {
             device,
             "aov",
             pixels * std::mem::size_of::<GpuAov>() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        )?;
+        // The recorded path: a count, then the vertices (std430/scalar: the
+        // array starts at offset 4).
+        let path_bytes = 4 + PATH_RECORD_VERTICES as u64 * std::mem::size_of::<GpuPathVertex>() as u64;
+        let path = Buffer::new(
+            device,
+            "recorded path",
+            path_bytes,
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
@@ -228,10 +266,15 @@ impl Renderer {
                 Binding::Buffer(caustic_map),
                 Binding::Buffer(volume_radiance),
                 Binding::Buffer(beam_map),
+                Binding::Image(&max_sample),
+                Binding::Buffer(&path),
             ]);
             pipeline.bind(&bindings);
         }
-        cmds.run(|_, cmd| accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL))?;
+        cmds.run(|_, cmd| {
+            accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
+            max_sample.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
+        })?;
         let tiles = (0..height)
             .step_by(TILE as usize)
             .flat_map(|y| {
@@ -245,7 +288,9 @@ impl Renderer {
             frame,
             _placeholder: placeholder,
             accum,
+            max_sample,
             readback,
+            path,
             aov,
             timer: GpuTimer::new(device)?,
             tiles,
@@ -276,10 +321,11 @@ impl Renderer {
         if let Some(v) = &mut self.volume {
             v.run(cmds, &self.timer, self.volume_samples)?;
         }
-        let accum = &self.accum;
+        let (accum, max_sample) = (&self.accum, &self.max_sample);
         cmds.run(|d, cmd| {
             full_barrier(d, cmd);
             accum.clear(cmd);
+            max_sample.clear(cmd);
         })?;
         self.samples = 0;
         self.render_seconds = 0.0;
@@ -360,6 +406,16 @@ impl Renderer {
         let radiance = sums[..pixels].iter().map(|s| [s[0] / n, s[1] / n, s[2] / n]).collect();
         let dropped_samples =
             sums[..pixels].iter().map(|s| (self.samples as f64 - s[3] as f64).round().max(0.0) as u64).sum();
+        let max_sample = &self.max_sample;
+        cmds.run(|d, cmd| {
+            full_barrier(d, cmd);
+            max_sample.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            max_sample.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback);
+            max_sample.transition(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL);
+            full_barrier(d, cmd);
+        })?;
+        let mut max_sample: Vec<[f32; 2]> = self.readback.read();
+        max_sample.truncate(pixels);
         let mut aov: Vec<GpuAov> = self.aov.read();
         aov.truncate(pixels);
         Ok(RenderOutput {
@@ -373,7 +429,34 @@ impl Renderer {
             caustics: self.caustics.as_ref().map(|c| CausticReport { irradiance: Vec::new(), ..c.report.clone() }),
             volume_seconds: self.volume_seconds(),
             dropped_samples,
+            max_sample,
         })
+    }
+
+    /// Traces sample `sample` of pixel `(x, y)` alone (the same random
+    /// numbers as in a render) and returns the events of its path, in order.
+    /// Needs a renderer built with [`RenderVariant::record_path`]; the
+    /// sample is also added to the accumulation.
+    pub fn trace_path(
+        &mut self,
+        cmds: &mut Commands,
+        (x, y): (u32, u32),
+        sample: u32,
+    ) -> Result<Vec<GpuPathVertex>, RenderError> {
+        assert!(x < self.size.0 && y < self.size.1, "pixel ({x}, {y}) outside the image");
+        self.path.write(0, &[0u8; 4]);
+        let push = RenderPush { tile_origin: [x, y], tile_size: [1, 1], sample_index: sample, write_aov: 0 };
+        let pipeline = &self.pipeline;
+        cmds.run(|d, cmd| {
+            full_barrier(d, cmd);
+            pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [1, 1, 1]);
+            full_barrier(d, cmd);
+        })?;
+        let bytes: Vec<u8> = self.path.read();
+        let count =
+            (u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as usize).min(PATH_RECORD_VERTICES as usize);
+        let size = std::mem::size_of::<GpuPathVertex>();
+        Ok((0..count).map(|i| bytemuck::pod_read_unaligned(&bytes[4 + i * size..4 + (i + 1) * size])).collect())
     }
 }
 
@@ -397,6 +480,8 @@ fn render_pipeline(
         BindingKind::StorageBuffer,
         BindingKind::StorageBuffer,
         BindingKind::StorageBuffer,
+        BindingKind::StorageImage,
+        BindingKind::StorageBuffer,
     ]);
     Ok(ComputePipeline::new(
         device,
@@ -411,6 +496,7 @@ fn render_pipeline(
             u32::from(caustics.is_some()),
             u32::from(volume),
             u32::from(caustics.is_some_and(|c| c.has_beams)),
+            u32::from(variant.record_path),
         ],
     )?)
 }
@@ -418,7 +504,7 @@ fn render_pipeline(
 /// Runs the caustic passes when `variant` asks for them and the scene needs
 /// them: a light that emits caustic rays, a specular object, a diffuse
 /// receiver, and a path depth that allows a specular vertex between a
-/// receiver and a light (max_depth ≥ 3).
+/// receiver and a light (max_depth ≥ 2).
 fn caustic_map(
     device: &Arc<Device>,
     gpu: &GpuScene,
@@ -428,12 +514,13 @@ fn caustic_map(
     variant: RenderVariant,
 ) -> Result<Option<CausticMap>, RenderError> {
     let max_depth = scene.image.max_depth.max(1);
-    if !variant.caustics || variant.shading != SHADING_FULL || !scene.needs_caustics() || max_depth < 3 {
+    if !variant.caustics || variant.shading != SHADING_FULL || !scene.needs_caustics() || max_depth < 2 {
         return Ok(None);
     }
     // A caustic path from the camera: the receiver (a bounce), the specular
-    // vertices (a bounce each), then the light found by the next segment.
-    let Some(mut grids) = emitters(scene, gpu.origin, max_depth - 2, scene.caustics.rays) else {
+    // vertices (a bounce each, the last vertex included), then the light
+    // found by the segment after them (render.comp, "the last vertex").
+    let Some(mut grids) = emitters(scene, gpu.origin, max_depth - 1, scene.caustics.rays) else {
         log::warn!("a light is inside the bounds of the specular objects: caustics are left to the path tracer");
         return Ok(None);
     };
@@ -446,7 +533,7 @@ fn caustic_map(
         let asked = total(&grids);
         let scale = fits as f64 / asked as f64;
         let fewer = ((scene.caustics.rays as f64 * scale * 0.95) as u32).max(1);
-        grids = emitters(scene, gpu.origin, max_depth - 2, fewer).unwrap_or_default();
+        grids = emitters(scene, gpu.origin, max_depth - 1, fewer).unwrap_or_default();
         log::warn!(
             "{asked} caustic rays do not fit in one storage buffer of this device ({fits} rays); tracing {} \
              ({} per light and light sample)",
