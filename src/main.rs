@@ -179,10 +179,9 @@ enum BenchShading {
     Albedo,
 }
 
-#[derive(Parser, Debug)]
-struct OutliersArgs {
-    /// Scene file (TOML). Omit it to check the built-in default scene.
-    scene: Option<PathBuf>,
+/// Image size and seed overrides of `render` and `outliers`.
+#[derive(Parser, Debug, Default, Clone)]
+struct FrameArgs {
     /// Image width in pixels (overrides `image.width`).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     width: Option<u32>,
@@ -192,6 +191,14 @@ struct OutliersArgs {
     /// Random seed (overrides `image.seed`).
     #[arg(long)]
     seed: Option<u32>,
+}
+
+#[derive(Parser, Debug)]
+struct OutliersArgs {
+    /// Scene file (TOML). Omit it to check the built-in default scene.
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    frame: FrameArgs,
     #[command(flatten)]
     quality: QualityArgs,
     /// The bound on a sample's luminance (default: the one the scene's
@@ -226,15 +233,8 @@ struct RenderArgs {
     /// name without one of those extensions writes both `NAME.png` and `NAME.exr`.
     #[arg(short, long, default_value = "render")]
     output: PathBuf,
-    /// Image width in pixels (overrides `image.width`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    width: Option<u32>,
-    /// Image height in pixels (overrides `image.height`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    height: Option<u32>,
-    /// Random seed (overrides `image.seed`).
-    #[arg(long)]
-    seed: Option<u32>,
+    #[command(flatten)]
+    frame: FrameArgs,
     /// Write the EXR with 16-bit half floats instead of 32-bit floats.
     #[arg(long)]
     half: bool,
@@ -340,13 +340,13 @@ fn read_scene(path: Option<&Path>) -> Result<Scene> {
 fn load(args: &RenderArgs) -> Result<Scene> {
     let mut scene = read_scene(args.scene.as_deref())?;
     args.quality.apply(&mut scene);
-    if let Some(w) = args.width {
+    if let Some(w) = args.frame.width {
         scene.image.width = w;
     }
-    if let Some(h) = args.height {
+    if let Some(h) = args.frame.height {
         scene.image.height = h;
     }
-    if let Some(s) = args.seed {
+    if let Some(s) = args.frame.seed {
         scene.image.seed = s;
     }
     Ok(scene)
@@ -447,9 +447,7 @@ fn outliers(args: OutliersArgs) -> Result<()> {
     use quadray::passes::{GpuScene, RenderVariant, Renderer};
     let render_args = RenderArgs {
         scene: args.scene.clone(),
-        width: args.width,
-        height: args.height,
-        seed: args.seed,
+        frame: args.frame.clone(),
         quality: args.quality.clone(),
         ..Default::default()
     };
@@ -478,17 +476,16 @@ fn outliers(args: OutliersArgs) -> Result<()> {
     )?;
     let im = &scene.image;
     let variant = RenderVariant { filter: im.filter.constant(), caustics: false, volume: false, ..Default::default() };
-    let mut progress = ProgressBar::new(false);
-    let out = quadray::passes::render(
-        device,
-        &mut cmds,
-        &gpu,
-        &scene,
-        (im.width, im.height, im.spp),
-        variant,
-        &mut |d, t| progress.update(d, t),
-    )?;
-    progress.finish();
+    // Renders `spp` samples of `s` (this scene, perhaps with another seed).
+    let render = |cmds: &mut quadray::vk::Commands, s: &Scene, spp: u32| {
+        let mut progress = ProgressBar::new(false);
+        let out = quadray::passes::render(device, cmds, &gpu, s, (im.width, im.height, spp), variant, &mut |d, t| {
+            progress.update(d, t)
+        });
+        progress.finish();
+        out
+    };
+    let out = render(&mut cmds, &scene, im.spp)?;
     let samples = out.width as u64 * out.height as u64 * out.spp as u64;
     let found = outliers(&out, bound);
     if let Some(m) = largest_sample(&out) {
@@ -516,17 +513,7 @@ fn outliers(args: OutliersArgs) -> Result<()> {
     if let Some(reference_spp) = args.regions {
         let mut reference_scene = scene.clone();
         reference_scene.image.seed = scene.image.seed ^ 0x9e37_79b9;
-        let mut progress = ProgressBar::new(false);
-        let reference = quadray::passes::render(
-            device,
-            &mut cmds,
-            &gpu,
-            &reference_scene,
-            (im.width, im.height, reference_spp),
-            variant,
-            &mut |d, t| progress.update(d, t),
-        )?;
-        progress.finish();
+        let reference = render(&mut cmds, &reference_scene, reference_spp)?;
         let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
         let e = quadray::metrics::region_relative_mse(&reference, &out, 2, 64)?;
         println!("\nrelative MSE at {} spp against {reference_spp} spp:", out.spp);

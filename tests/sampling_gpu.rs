@@ -159,6 +159,12 @@ fn f3(v: DVec3) -> [f32; 3] {
     v.as_vec3().to_array()
 }
 
+/// A BSDF case of the twin shader: sample `m` from `wo` with `u`, and
+/// evaluate it at (`wo`, `wi`).
+fn bsdf_case(m: &Material, wo: DVec3, wi: DVec3, u: [f32; 3]) -> TwinCase {
+    TwinCase { op: 0, mat: GpuMaterial::from(m), light: GpuLight::default(), wo: f3(wo), wi: f3(wi), u, x: [0.0; 3] }
+}
+
 #[test]
 fn gpu_bsdf_sampling_matches_the_cpu_twin() {
     let mut rng = Pcg64::seed_from_u64(5);
@@ -173,15 +179,7 @@ fn gpu_bsdf_sampling_matches_the_cpu_twin() {
             let u = [rng.gen::<f32>(), rng.gen::<f32>(), rng.gen::<f32>()];
             // Round the inputs to f32 first so both sides see the same numbers.
             let (wo, wi) = (d3(f3(wo)), d3(f3(wi)));
-            cases.push(TwinCase {
-                op: 0,
-                mat: GpuMaterial::from(m),
-                light: GpuLight::default(),
-                wo: f3(wo),
-                wi: f3(wi),
-                u,
-                x: [0.0; 3],
-            });
+            cases.push(bsdf_case(m, wo, wi, u));
             inputs.push((m.clone(), wo, wi, u.map(|v| v as f64)));
         }
     }
@@ -305,15 +303,7 @@ fn gpu_bsdf_weights_never_exceed_their_bound() {
         let mut push = |wo: DVec3, wi: DVec3, u: [f64; 3]| {
             let (wo, wi) = (d3(f3(wo)), d3(f3(wi)));
             let u = u.map(|v| (v as f32).min(1.0 - f32::EPSILON / 2.0));
-            cases.push(TwinCase {
-                op: 0,
-                mat: GpuMaterial::from(m),
-                light: GpuLight::default(),
-                wo: f3(wo),
-                wi: f3(wi),
-                u,
-                x: [0.0; 3],
-            });
+            cases.push(bsdf_case(m, wo, wi, u));
             inputs.push((m.clone(), wo, wi));
         };
         for _ in 0..300 {
