@@ -241,9 +241,16 @@ layout(set = 0, binding = BINDING_RENDER_PATH, scalar) buffer PathRecord {
 void record(uint event, uint object, uint material, uint lobe, float t, float cosO, float cosI, float pdf, vec3 position,
             vec3 weight, vec3 throughput, vec3 radiance) {
     if (RECORD_PATH == 0u) return;
+    // `count` counts every event; the last slot is kept for EVENT_END, so
+    // that a path longer than the record still shows how it ended (the host
+    // reports the events left out).
     uint i = path.count;
-    if (i >= PATH_RECORD_VERTICES) return;
     path.count = i + 1u;
+    if (event == EVENT_END) {
+        i = min(i, PATH_RECORD_VERTICES - 1u);
+    } else if (i >= PATH_RECORD_VERTICES - 1u) {
+        return;
+    }
     path.vertices[i] = PathVertex(event, object, material, lobe, t, cosO, cosI, pdf, float[3](position.x, position.y,
         position.z), float[3](weight.x, weight.y, weight.z), float[3](throughput.x, throughput.y, throughput.z),
         float[3](radiance.x, radiance.y, radiance.z));
@@ -463,12 +470,15 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     uint bounce = 0u;
     uint step = 0u;
     bool alive = true;
+    // One past the last segment: the emitter-only one after the last vertex
+    // (the test shading modes end where they always did, without it).
+    uint lastBounce = frame.maxDepth + (SHADING_MODE == SHADING_FULL ? 1u : 0u);
     ShadowRay sr;
     // One ray query per iteration, at this one call site: a waiting shadow
     // ray first, else the path's next segment.
     for (;;) {
         bool shadow = shadowRayCount > 0u;
-        if (!shadow && !(alive && bounce <= frame.maxDepth && step < 4u * frame.maxDepth + 8u)) break;
+        if (!shadow && !(alive && bounce < lastBounce && step < 4u * frame.maxDepth + 8u)) break;
         if (shadow) sr = shadowRayCount == 2u ? shadowRay1 : shadowRay0;
         SceneHit h = traceSceneWith(shadow ? sr.origin : o, shadow ? sr.dir : d, 0.0, shadow ? sr.dist : 1e30, shadow);
         if (shadow) {
@@ -478,7 +488,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             bool visible = h.object == NO_HIT && noOtherLightInFront(sr.origin, sr.dir, sr.dist, sr.light);
             if (visible) radiance += brings;
             record(EVENT_SHADOW, sr.light, NO_TEXTURE, visible ? 1u : 0u, sr.dist, 0.0, 0.0, visible ? 1.0 : 0.0,
-                   sr.origin + sr.dist * sr.dir, brings, throughput, radiance);
+                   sr.origin + sr.dist * sr.dir, brings, vec3(0.0), radiance);
             continue;
         }
         uint segment = step++;
@@ -637,6 +647,10 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         }
         vec3 p = o + h.t * d;
         radiance += throughput * v3(mat.emission);
+        if (any(greaterThan(v3(mat.emission), vec3(0.0)))) {
+            record(EVENT_EMITTER, h.object, matIndex, NO_HIT, h.t, 0.0, 0.0, 1.0, p, throughput * v3(mat.emission),
+                   throughput, radiance);
+        }
         // A dielectric's shading normal must agree with the geometric one on
         // which side the ray comes from (the media stack follows the
         // geometric side, the refraction's η the shading side); where a

@@ -456,8 +456,10 @@ fn outliers(args: OutliersArgs) -> Result<()> {
         Some(b) => b,
         None => {
             let b = SampleBound::of(&scene).context("give the bound with --bound")?;
+            let media =
+                if b.media { format!(" + 0.5 x {} segments in media", 4 * b.max_depth + 8) } else { String::new() };
             eprintln!(
-                "bound: {:.4} = largest emitted luminance {:.4} x (1 + 1.5 x {} bounces)",
+                "bound: {:.4} = largest emitted luminance {:.4} x (1 + 1.5 x {} bounces{media})",
                 b.luminance, b.emitted, b.max_depth
             );
             b.luminance

@@ -134,7 +134,8 @@ fn the_largest_sample_aov_is_a_sample_the_recorder_reproduces() {
         let (x, y) = (i as u32 % width, i as u32 / width);
         let m = out.max_sample[i];
         let path = recorder.trace_path(&mut cmds, (x, y), m[1] as u32).unwrap();
-        let end = path.last().expect("a recorded path");
+        assert_eq!(path.left_out, 0);
+        let end = path.events.last().expect("a recorded path");
         assert_eq!(end.event, quadray::shader_interface::EVENT_END, "{}", describe_path(&scene, &path));
         let got = luminance(end.radiance);
         assert!((got - m[0]).abs() <= 1e-5 * m[0].max(1.0), "pixel ({x}, {y}): recorded {got}, AOV {}", m[0]);

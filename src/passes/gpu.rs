@@ -372,7 +372,8 @@ pub struct GpuPathVertex {
     pub position: [f32; 3],
     /// The sample's weight, or the contribution an emitter or shadow ray brings.
     pub weight: [f32; 3],
-    /// The path throughput after the event.
+    /// The path throughput after the event (0 for light samples and shadow
+    /// rays: what they bring includes the throughput of their vertex).
     pub throughput: [f32; 3],
     /// The sample's radiance so far.
     pub radiance: [f32; 3],

@@ -12,7 +12,7 @@ pub mod volume;
 
 pub use caustics::{CausticMap, CausticReport};
 pub use probe::ProbePass;
-pub use render::{render, RenderOutput, RenderVariant, Renderer};
+pub use render::{render, RecordedPath, RenderOutput, RenderVariant, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene};
 pub use texprobe::TexProbePass;
 pub use volume::VolumeLight;

@@ -10,9 +10,9 @@
 //! (weighted by multiple importance sampling, w ≤ 1) and next-event
 //! estimation. With the power heuristic, light sampling's contribution is
 //! `f cos L w_l / p_l = (f cos / p_b) · L · p_l p_b / (p_l² + p_b²)`, at most
-//! `a L / 2` where `a = f cos / p_b` is the BSDF sample's weight, at most
-//! the directional albedo (≤ 1, see `sampling::bsdf`'s weight tests), and
-//! `L` the largest emitted radiance. Every vertex, the last included, uses
+//! `a L / 2` where `a = f cos / p_b` is the BSDF's weight in that direction,
+//! at most 1 (the albedo for Lambert; tests/sampling_gpu.rs checks it at
+//! every angle), and `L` the largest emitted radiance. Every vertex, the last included, uses
 //! multiple importance sampling (render.comp: the last vertex still samples
 //! its BSDF and looks for an emitter in that direction), so each vertex adds
 //! at most `1.5 L` times a throughput of at most 1 (smooth interfaces scale
@@ -22,6 +22,14 @@
 //! camera ray may see directly, a sample of a path of at most `D` bounces is
 //! at most `L (1 + 1.5 D)`.
 //!
+//! In a scene with participating media, each segment of the path may also
+//! add an equiangular estimate of its single scattering toward a light, at
+//! most `L / 2` by the same argument (its competing strategy is distance
+//! sampling and the phase function, whose weight is the medium's albedo ≤ 1),
+//! and a scattering event in a medium is a bounce like a surface vertex. A
+//! path has at most `4 D + 8` segments (index-matched interfaces split a
+//! bounce's segment), so the bound grows by `L (2 D + 4)` there.
+//!
 //! The bound needs area emitters: point and directional lights have no
 //! radiance, and a sharp glossy lobe can legitimately turn one into an
 //! arbitrarily bright single sample. The caustic and volume passes add a
@@ -30,8 +38,7 @@
 
 use std::fmt::Write as _;
 
-use super::gpu::GpuPathVertex;
-use super::RenderOutput;
+use super::{RecordedPath, RenderOutput};
 use crate::scene::{Light, Scene};
 use crate::shader_interface::{
     EVENT_EMITTER, EVENT_END, EVENT_LIGHT_SAMPLE, EVENT_MEDIUM, EVENT_PASS_THROUGH, EVENT_ROULETTE, EVENT_SHADOW,
@@ -58,6 +65,9 @@ pub struct SampleBound {
     pub emitted: f32,
     /// Path length in bounces.
     pub max_depth: u32,
+    /// True when the scene has participating media (the bound then counts
+    /// an equiangular estimate per segment).
+    pub media: bool,
 }
 
 impl SampleBound {
@@ -85,7 +95,10 @@ impl SampleBound {
             emitted = emitted.max(brightest * env.scale);
         }
         let max_depth = scene.image.max_depth.max(1);
-        Ok(Self { luminance: emitted * (1.0 + 1.5 * max_depth as f32), emitted, max_depth })
+        let media = scene.has_media();
+        let d = max_depth as f32;
+        let per_segment = if media { 0.5 * (4.0 * d + 8.0) } else { 0.0 };
+        Ok(Self { luminance: emitted * (1.0 + 1.5 * d + per_segment), emitted, max_depth, media })
     }
 }
 
@@ -137,12 +150,16 @@ fn rgb(c: [f32; 3]) -> String {
 /// A readable account of a recorded path, one line per event: the object
 /// and material, the event, the cosines, pdfs and weights, the throughput
 /// and the radiance so far.
-pub fn describe_path(scene: &Scene, path: &[GpuPathVertex]) -> String {
+pub fn describe_path(scene: &Scene, path: &RecordedPath) -> String {
     let objects: Vec<String> = scene.objects.iter().map(|o| o.name.clone()).collect();
     let materials: Vec<String> = scene.materials.iter().map(|m| m.name.clone()).collect();
     let light = |i: u32| if i == NO_HIT { "environment".to_string() } else { format!("lights[{i}]") };
     let mut s = String::new();
-    for (k, v) in path.iter().enumerate() {
+    let end = path.events.len().saturating_sub(1);
+    for (k, v) in path.events.iter().enumerate() {
+        if k == end && path.left_out > 0 {
+            let _ = writeln!(s, "      … {} events left out (the record holds {})", path.left_out, path.events.len());
+        }
         let p = rgb(v.position);
         let line = match v.event {
             EVENT_SURFACE => format!(
@@ -159,6 +176,13 @@ pub fn describe_path(scene: &Scene, path: &[GpuPathVertex]) -> String {
                 v.cos_o,
                 v.cos_i,
                 v.pdf,
+                rgb(v.weight),
+                rgb(v.throughput)
+            ),
+            EVENT_EMITTER if v.material != NO_TEXTURE => format!(
+                "emissive surface {} ({}): brings {}, throughput {}",
+                name_of(&objects, v.object),
+                name_of(&materials, v.material),
                 rgb(v.weight),
                 rgb(v.throughput)
             ),

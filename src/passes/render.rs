@@ -70,6 +70,16 @@ impl RenderOutput {
     }
 }
 
+/// The events of one recorded path ([`Renderer::trace_path`]).
+#[derive(Clone, Debug, Default)]
+pub struct RecordedPath {
+    /// The events in order. A path with more events than the record holds
+    /// (`PATH_RECORD_VERTICES`) keeps its first ones and its end.
+    pub events: Vec<GpuPathVertex>,
+    /// How many events before the end did not fit in the record.
+    pub left_out: u32,
+}
+
 /// Progress of a render: (work done, total work), in tile-samples.
 pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
 
@@ -436,13 +446,14 @@ impl Renderer {
     /// Traces sample `sample` of pixel `(x, y)` alone (the same random
     /// numbers as in a render) and returns the events of its path, in order.
     /// Needs a renderer built with [`RenderVariant::record_path`]; the
-    /// sample is also added to the accumulation.
+    /// sample is also added to the accumulation (without counting it: use
+    /// such a renderer only to record).
     pub fn trace_path(
         &mut self,
         cmds: &mut Commands,
         (x, y): (u32, u32),
         sample: u32,
-    ) -> Result<Vec<GpuPathVertex>, RenderError> {
+    ) -> Result<RecordedPath, RenderError> {
         assert!(x < self.size.0 && y < self.size.1, "pixel ({x}, {y}) outside the image");
         self.path.write(0, &[0u8; 4]);
         let push = RenderPush { tile_origin: [x, y], tile_size: [1, 1], sample_index: sample, write_aov: 0 };
@@ -453,10 +464,12 @@ impl Renderer {
             full_barrier(d, cmd);
         })?;
         let bytes: Vec<u8> = self.path.read();
-        let count =
-            (u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as usize).min(PATH_RECORD_VERTICES as usize);
+        let total = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+        let kept = total.min(PATH_RECORD_VERTICES) as usize;
         let size = std::mem::size_of::<GpuPathVertex>();
-        Ok((0..count).map(|i| bytemuck::pod_read_unaligned(&bytes[4 + i * size..4 + (i + 1) * size])).collect())
+        let events =
+            (0..kept).map(|i| bytemuck::pod_read_unaligned(&bytes[4 + i * size..4 + (i + 1) * size])).collect();
+        Ok(RecordedPath { events, left_out: total - kept as u32 })
     }
 }
 
