@@ -55,14 +55,18 @@ pub fn flip_mean(reference: &RenderOutput, test: &RenderOutput, exposure: f32) -
 /// and channels of (test − ref)² / (ref² + ε), ε = [`RELATIVE_MSE_EPSILON`].
 pub fn relative_mse(reference: &RenderOutput, test: &RenderOutput) -> Result<f64, MetricError> {
     check_sizes(reference, test)?;
-    let sum: f64 = reference
-        .radiance
-        .iter()
-        .zip(&test.radiance)
-        .flat_map(|(r, t)| r.iter().zip(t).map(|(&r, &t)| (f64::from(r), f64::from(t))))
-        .map(|(r, t)| (t - r) * (t - r) / (r * r + RELATIVE_MSE_EPSILON))
-        .sum();
+    let sum: f64 = reference.radiance.iter().zip(&test.radiance).map(|(r, t)| relative_squared_error(r, t)).sum();
     Ok(sum / (3 * reference.radiance.len()) as f64)
+}
+
+/// One pixel's (test − ref)² / (ref² + ε), summed over its channels.
+fn relative_squared_error(reference: &[f32; 3], test: &[f32; 3]) -> f64 {
+    reference
+        .iter()
+        .zip(test)
+        .map(|(&r, &t)| (f64::from(r), f64::from(t)))
+        .map(|(r, t)| (t - r) * (t - r) / (r * r + RELATIVE_MSE_EPSILON))
+        .sum()
 }
 
 /// Relative MSE over the whole image and over its regions: the pixels that
@@ -107,16 +111,6 @@ pub fn region_relative_mse(
     }
     let (w, h) = (reference.width as i64, reference.height as i64);
     let m = margin as i64;
-    let pixel_error = |i: usize| -> f64 {
-        let (r, t) = (reference.radiance[i], test.radiance[i]);
-        (0..3)
-            .map(|c| {
-                let (r, t) = (f64::from(r[c]), f64::from(t[c]));
-                (t - r) * (t - r) / (r * r + RELATIVE_MSE_EPSILON)
-            })
-            .sum::<f64>()
-            / 3.0
-    };
     let mut sums: std::collections::BTreeMap<u32, (usize, f64)> = Default::default();
     for y in 0..h {
         for x in 0..w {
@@ -131,7 +125,7 @@ pub fn region_relative_mse(
             if interior {
                 let e = sums.entry(object).or_default();
                 e.0 += 1;
-                e.1 += pixel_error(i);
+                e.1 += relative_squared_error(&reference.radiance[i], &test.radiance[i]) / 3.0;
             }
         }
     }

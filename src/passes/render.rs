@@ -397,34 +397,33 @@ impl Renderer {
         Ok(())
     }
 
+    /// Copies `image` (one of the renderer's, in GENERAL layout) into the
+    /// readback buffer and reads it as texels of type `T`; the vector may be
+    /// longer than the image (the buffer fits the largest of them).
+    fn read_image<T: bytemuck::Pod>(&self, cmds: &mut Commands, image: &Image) -> Result<Vec<T>, RenderError> {
+        let readback = &self.readback;
+        cmds.run(|d, cmd| {
+            full_barrier(d, cmd);
+            image.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            image.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback);
+            image.transition(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL);
+            full_barrier(d, cmd);
+        })?;
+        Ok(readback.read())
+    }
+
     /// Reads back the mean of the samples so far, the AOVs and the times.
     pub fn output(&mut self, cmds: &mut Commands) -> Result<RenderOutput, RenderError> {
         let (width, height) = self.size;
         let pixels = width as usize * height as usize;
-        let (accum, readback) = (&self.accum, &self.readback);
-        cmds.run(|d, cmd| {
-            full_barrier(d, cmd);
-            accum.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-            accum.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback);
-            accum.transition(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL);
-            full_barrier(d, cmd);
-        })?;
-        let sums: Vec<[f32; 4]> = self.readback.read();
+        let sums: Vec<[f32; 4]> = self.read_image(cmds, &self.accum)?;
         // The fourth channel counts the finite samples; the mean is over
         // all samples, the dropped ones black.
         let n = self.samples.max(1) as f32;
         let radiance = sums[..pixels].iter().map(|s| [s[0] / n, s[1] / n, s[2] / n]).collect();
         let dropped_samples =
             sums[..pixels].iter().map(|s| (self.samples as f64 - s[3] as f64).round().max(0.0) as u64).sum();
-        let max_sample = &self.max_sample;
-        cmds.run(|d, cmd| {
-            full_barrier(d, cmd);
-            max_sample.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-            max_sample.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback);
-            max_sample.transition(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL);
-            full_barrier(d, cmd);
-        })?;
-        let mut max_sample: Vec<[f32; 2]> = self.readback.read();
+        let mut max_sample: Vec<[f32; 2]> = self.read_image(cmds, &self.max_sample)?;
         max_sample.truncate(pixels);
         let mut aov: Vec<GpuAov> = self.aov.read();
         aov.truncate(pixels);
