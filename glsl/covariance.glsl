@@ -35,13 +35,14 @@ mat4 covClamp(mat4 m) {
     return m;
 }
 
-// At the camera: a pixel's box filter of angular width `pixelAngle`
-// (variance w²/12), no spatial extent (a pinhole).
-PathCovariance covCamera(vec3 d, vec3 up, float pixelAngle) {
+// At the camera: the footprint's share of the pixel filter, a Gaussian of
+// angular standard deviation `sigma` (render.comp, footprintSigma), no
+// spatial extent (a pinhole).
+PathCovariance covCamera(vec3 d, vec3 up, float sigma) {
     PathCovariance c;
     c.e1 = normalize(cross(d, up));
     c.e2 = cross(c.e1, d);
-    float v = pixelAngle * pixelAngle / 12.0;
+    float v = sigma * sigma;
     c.p = mat4(0.0);
     c.p[2][2] = v;
     c.p[3][3] = v;

@@ -23,12 +23,23 @@ layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
     uint envHeight;
     float envScale;
     Medium fog;       // outside the objects (density 0: none)
+    float pixelSigma;         // the Gaussian pixel filter's σ, in pixels
+    float footprintFraction;  // the share of its variance that filtered modes' footprints carry
 } frame;
 
 // The direction through image position `pixel` (in pixels, y down).
 vec3 cameraRay(vec2 pixel) {
     vec2 ndc = vec2(2.0 * pixel.x / float(frame.width) - 1.0, 1.0 - 2.0 * pixel.y / float(frame.height));
     return normalize(frame.forward + ndc.x * frame.right + ndc.y * frame.up);
+}
+
+// The pixel filter (render.comp, cameraJitter): a point u of the unit
+// square taken by the Box-Muller transform to an offset (pixels) from the
+// pixel's centre with a Gaussian of standard deviation `sigma`.
+vec2 gaussianPixelOffset(vec2 u, float sigma) {
+    float r = sigma * sqrt(-2.0 * log(1.0 - u.x));
+    float a = 6.2831853 * u.y;
+    return r * vec2(cos(a), sin(a));
 }
 
 // Image position (pixels, y down) of p; false behind the camera.

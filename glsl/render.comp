@@ -69,10 +69,14 @@ layout(set = 0, binding = BINDING_RENDER_BEAMS, scalar) readonly buffer BeamMap 
 
 // Specialisation constant: FILTER_NONE, FILTER_RAY_CONES or FILTER_COVARIANCE.
 layout(constant_id = 2) const uint FILTER_MODE = FILTER_NONE;
+// Specialisation constant: LOOKUP_PROBES (trilinear probes, the default) or
+// LOOKUP_EWA (the reference lookup), for the filtered modes.
+layout(constant_id = 8) const uint LOOKUP_MODE = LOOKUP_PROBES;
 
 // A texture lookup over a footprint; FILTER_NONE ignores the footprint.
 vec4 lookup(uint index, Footprint fp) {
-    return FILTER_MODE == FILTER_NONE ? mapAt(index, fp.uv) : ewaLookup(index, fp);
+    if (FILTER_MODE == FILTER_NONE) return mapAt(index, fp.uv);
+    return LOOKUP_MODE == LOOKUP_EWA ? ewaLookup(index, fp) : probeLookup(index, fp);
 }
 
 // ---- The environment map --------------------------------------------------
@@ -151,9 +155,13 @@ Material surfaceAt(SceneHit h, vec3 d, mat2 footprint, out vec3 shadingNormal) {
     if (mat.normalMap == NO_TEXTURE && mat.displacementMap == NO_TEXTURE) return mat;
     vec3 dpdu, dpdv;
     tangentsFromGradients(gu, gv, n, dpdu, dpdv);
-    // Filtered modes read the maps' slope moments over the footprint (LEAN):
-    // the mean slope bends the normal, the variance widens the lobe.
-    bool lean = FILTER_MODE != FILTER_NONE;
+    // Filtered modes read the maps' slope moments over the footprint (LEAN)
+    // on glossy lobes: the mean slope bends the normal, the variance widens
+    // the lobe, which is how a glossy lobe averages over the normals in the
+    // footprint. A Lambert or mirror lobe has no roughness to take the
+    // variance, and shading with the mean normal would filter before the
+    // (nonlinear) shading: it reads the normal at the footprint's centre.
+    bool lean = FILTER_MODE != FILTER_NONE && (mat.kind == MATERIAL_CONDUCTOR || mat.kind == MATERIAL_DIELECTRIC);
     float slopeVar = 0.0;
     if (mat.displacementMap != NO_TEXTURE) {
         // Bump mapping: the normal of p + scale · height(u, v) · n.
@@ -281,6 +289,33 @@ float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
 
 // Number of light-sampling choices: the lights, plus the environment.
 uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
+
+// ---- The pixel filter -----------------------------------------------------
+// One pixel filter for every mode and for the reference: a Gaussian of
+// σ = frame.pixelSigma pixels (PIXEL_FILTER_SIGMA, src/passes/render.rs),
+// sampled by the camera rays' jitter (filter importance sampling, as in
+// pbrt-v4), so that the pixel value is the plain mean of its samples.
+// A filtered mode splits the filter's variance: the footprint carries the
+// fraction f = frame.footprintFraction (σ√f, which shrinks with the sample
+// count) and the jitter the rest (σ√(1 − f)). Gaussians convolve by adding
+// variances, so jitter ⊛ footprint is the pixel filter, and a filtered
+// sample's expectation is the supersampled pixel value wherever the texture
+// mapping is locally affine; `none` jitters over the whole filter.
+float footprintSigma() { return FILTER_MODE == FILTER_NONE ? 0.0 : frame.pixelSigma * sqrt(frame.footprintFraction); }
+
+// The jitter of sample `sampleIndex` in pixel `pix`, in pixels from the
+// pixel's centre: a stratified point (the R2 sequence, M. Roberts 2018, in
+// 32-bit fixed point, rotated per pixel and seed by Cranley-Patterson)
+// taken to the Gaussian by the Box-Muller transform.
+vec2 cameraJitter(uvec2 pix, uint sampleIndex) {
+    float f = FILTER_MODE == FILTER_NONE ? 0.0 : frame.footprintFraction;
+    float sigma = frame.pixelSigma * sqrt(max(1.0 - f, 0.0));
+    uint rx = pcgHash(pix.x ^ pcgHash(pix.y ^ pcgHash(frame.seed ^ 0x2545f491u)));
+    uint ry = pcgHash(rx);
+    // α = (0.7548776662, 0.5698402910) · 2^32.
+    uint ux = sampleIndex * 3242174890u + rx, uy = sampleIndex * 2447445414u + ry;
+    return gaussianPixelOffset(vec2(float(ux >> 8), float(uy >> 8)) * (1.0 / 16777216.0), sigma);
+}
 
 // Shadow rays are not traced where next-event estimation makes them: they
 // wait in this queue and tracePath traces them at the same call site as
@@ -425,16 +460,17 @@ bool survives(inout vec3 throughput, float etaScale, uint bounce, inout uint rng
 vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     MediaStack media = emptyStack();
     // Ray cone (Akenine-Möller et al., "Improved Shader and Texture Level of
-    // Detail Using Ray Cones", JCGT 2021): width at the ray's origin and
-    // spread angle, starting from the pixel's angle at the camera. Curved
-    // surfaces turn the spread by their exact mean curvature (below); rough
-    // and diffuse bounces widen it by twice their lobe's angular width (GGX
-    // α, 1 rad for Lambert), a heuristic.
+    // Detail Using Ray Cones", JCGT 2021), kept as a Gaussian: σ of the
+    // width at the ray's origin and of the spread angle, starting from the
+    // footprint's share of the pixel filter (cameraJitter). Curved surfaces
+    // turn the spread by their exact mean curvature (below). A rough or
+    // diffuse lobe does not widen it: the lobe is sampled, and counting its
+    // bandwidth in the footprint as well would filter twice.
     float coneWidth = 0.0;
     float pixelAngle = 2.0 * length(frame.up) / float(frame.height);
-    float coneSpread = pixelAngle;
-    // Covariance footprints (FILTER_COVARIANCE), from the pixel's filter.
-    PathCovariance cov = covCamera(d, normalize(frame.up), pixelAngle);
+    float coneSpread = footprintSigma() * pixelAngle;
+    // Covariance footprints (FILTER_COVARIANCE), from the same share.
+    PathCovariance cov = covCamera(d, normalize(frame.up), footprintSigma() * pixelAngle);
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
     // The product of the η² factors refractions divided the throughput by
@@ -546,16 +582,13 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 scatterDir = d;
                 scatterT = ts;
                 scatterDensity = med.density * exp(-med.density * ts);
-                // Footprints: travel to p, then the phase lobe widens the
-                // angles (its angular spread taken as √(1 − |g|) rad, a
-                // heuristic: 1 rad for isotropic scattering).
-                float phaseSigma = sqrt(1.0 - abs(med.anisotropy));
+                // Footprints: travel to p and turn to the new direction (the
+                // phase lobe is sampled, so its spread is not added).
                 if (FILTER_MODE == FILTER_COVARIANCE) {
                     covTravel(cov, ts);
-                    covScatter(cov, wi, phaseSigma);
+                    covScatter(cov, wi, 0.0);
                 } else if (FILTER_MODE == FILTER_RAY_CONES) {
                     coneWidth += coneSpread * ts;
-                    coneSpread += 2.0 * phaseSigma;
                 }
                 d = wi;
                 o = p;
@@ -624,14 +657,14 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             covTravel(cov, h.t);
             footprint = covOnSurface(cov, d, h.normal, ct1, ct2, covInv);
         } else {
-            // A box of width w has σ = w / √12.
-            footprint = coneFootprint(d, h.normal, width * 0.28867513);
+            footprint = coneFootprint(d, h.normal, width);
         }
         Material mat = surfaceAt(h, d, footprint, ns);
         if (SHADING_MODE == SHADING_NONE) return v3(mat.albedo);
         if (SHADING_MODE == SHADING_MIRRORED_ALBEDO && mat.kind != MATERIAL_MIRROR) {
             return throughput * v3(mat.albedo);
         }
+        if (SHADING_MODE == SHADING_GLOSSY_ALBEDO && mat.kind == MATERIAL_DIFFUSE) return throughput * v3(mat.albedo);
         uint matIndex = objects[h.object].material;
         bool entering = dot(d, h.normal) < 0.0;
         if (mat.kind == MATERIAL_DIELECTRIC) {
@@ -665,7 +698,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         bool primaryReceiver = CAUSTICS_ENABLED != 0u && bounce == 0u && mat.kind == MATERIAL_DIFFUSE
             && receivers[pixel].object == h.object;
         if (primaryReceiver) radiance += throughput * v3(mat.albedo) / PI * FIXED_POINT_RGB(causticMap, pixel);
-        if (!isDelta(mat)) {
+        if (SHADING_MODE == SHADING_FULL && !isDelta(mat)) {
             vec3 c = nextEvent(mat, frameW, wo, d, p, h.normal, h.offset, med, rng, sr);
             queueShadowRay(sr, throughput * c);
         }
@@ -727,20 +760,15 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             }
             mat2 shape = shapeOperator(h, ct1, ct2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
             if (FILTER_MODE == FILTER_COVARIANCE) {
-                // Angular standard deviation of the lobe: about √2 α for GGX
-                // reflection, about 0.6 rad for Lambert, 0 for delta lobes.
-                float lobe =
-                    isDelta(mat) ? 0.0 : (mat.kind == MATERIAL_DIFFUSE ? 0.6 : 1.41421356 * materialAlpha(mat));
-                covBounce(cov, covInv, ct1, ct2, normalize(frameW * bs.wi), scale, shape, gain, lobe);
+                // The lobe is sampled (bs.wi): its bandwidth is not added.
+                covBounce(cov, covInv, ct1, ct2, normalize(frameW * bs.wi), scale, shape, gain, 0.0);
             } else {
                 // Ray cones: the curvature term of Akenine-Möller et al. 2021
                 // (the cone's edge rays turn by the gain times the mean
                 // curvature times the width; a convex mirror of radius R
-                // adds 2w/R), then the angle scale of a refraction, then the
-                // lobe's widening.
+                // adds 2w/R), then the angle scale of a refraction.
                 float kappa = 0.5 * (shape[0][0] + shape[1][1]);
                 coneSpread = coneSpread * scale.x + 0.5 * (gain.x + gain.y) * kappa * width;
-                if (!isDelta(mat)) coneSpread += 2.0 * (mat.kind == MATERIAL_DIFFUSE ? 1.0 : materialAlpha(mat));
                 coneWidth = width;
             }
         }
@@ -752,7 +780,8 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             etaScale *= etaRel * etaRel;
         }
         throughput *= bs.weight;
-        lastPdf = bs.pdf;
+        // The albedo modes weigh no emitter against light sampling.
+        lastPdf = SHADING_MODE == SHADING_FULL ? bs.pdf : 0.0;
         scatterDensity = 0.0;
         lastPoint = p;
         d = next;
@@ -780,14 +809,15 @@ void main() {
         vec3 n = h.normal;
         aov.normal = float[3](n.x, n.y, n.z);
         vec3 ns;
-        float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * 0.28867513;
+        // The whole pixel filter, as the footprint of the centre ray.
+        float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * frame.pixelSigma;
         vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, coneFootprint(d, h.normal, sigma), ns).albedo);
         aov.albedo = float[3](alb.x, alb.y, alb.z);
         aov.object = h.object;
         aovs[idx] = aov;
     }
 
-    vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + rand2(rng)), idx, rng);
+    vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + 0.5 + cameraJitter(pix, pc.sampleIndex)), idx, rng);
     // No NaN or Inf ever leaves the renderer: such a sample counts as black,
     // and the accumulation's fourth channel counts only the finite samples,
     // so that the host can report how many were dropped.

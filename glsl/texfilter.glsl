@@ -1,9 +1,8 @@
 // Filtered texture lookups over a footprint: an elliptical Gaussian in
-// (u, v), given by its two semi-axes (1σ), integrated by elliptical weighted
-// averaging (P. Heckbert, "Fundamentals of Texture Mapping and Image
-// Warping", 1989) over the mip level where the ellipse spans a few texels,
-// with a bounded number of taps and a bounded anisotropy. The including
-// shader declares `sampler2D textures[]` first.
+// (u, v), given by its two semi-axes (1σ). Two lookups: trilinear probes
+// along the major axis (probeLookup, the default) and elliptical weighted
+// averaging (ewaLookup, the reference), both with a bounded anisotropy. The
+// including shader declares `sampler2D textures[]` first.
 #ifndef TEXFILTER_GLSL
 #define TEXFILTER_GLSL
 
@@ -20,44 +19,145 @@ const float MIN_FOOTPRINT_COS = 1e-3;
 
 // The longest axis of the footprint may be at most this many times the shortest.
 const float MAX_ANISOTROPY = 16.0;
-// A lookup reads at most about this many texels (the level rises until it does).
-const float MAX_TAPS = 64.0;
+// An EWA lookup (the reference lookup, not the renderer's default) reads at
+// most about this many texels (the level rises until it does).
+const float MAX_TAPS = 1024.0;
 
 vec4 texelWrapped(uint index, ivec2 t, int level, ivec2 size) {
     ivec2 w = ((t % size) + size) % size;
     return texelFetch(textures[nonuniformEXT(index)], w, level);
 }
 
+// What every lookup below is asked for: the bilinear reconstruction of mip
+// level 0 (what `none` reads, and the reference) convolved with the
+// footprint's Gaussian. Filtering a coarser level L already applies a
+// kernel: level L's texels are box averages of 2^L x 2^L texels of level 0
+// (resample.rs, build_mips: variance (4^L - 1)/12 per axis, in level-0
+// texels), and its bilinear reconstruction is a tent of 2^L texels
+// (variance 4^L / 6) where level 0's is a tent of one (1/6). A lookup
+// therefore asks each level for the footprint's covariance *less* the blur
+// that the level itself adds, so that jitter ⊛ footprint stays the pixel
+// filter (render.comp, cameraJitter).
+
+// The footprint's covariance in level-0 texels: eigenvalues l1 >= l2
+// (variances along e1 and e2 = perp(e1)), the anisotropy bounded by
+// widening the minor axis.
+struct TexelEllipse {
+    vec2 e1;
+    float l1;
+    float l2;
+};
+
+TexelEllipse texelEllipse(Footprint fp, vec2 s0) {
+    vec2 a1 = fp.axis1 * s0, a2 = fp.axis2 * s0;
+    mat2 c = outerProduct(a1, a1) + outerProduct(a2, a2);
+    float tr = c[0][0] + c[1][1];
+    float det = c[0][0] * c[1][1] - c[0][1] * c[1][0];
+    float disc = sqrt(max(0.0, 0.25 * tr * tr - det));
+    TexelEllipse el;
+    el.l1 = 0.5 * tr + disc;
+    el.l2 = max(0.5 * tr - disc, 0.0);
+    el.e1 = abs(c[0][1]) > 1e-20 ? normalize(vec2(el.l1 - c[1][1], c[0][1]))
+                                  : (c[0][0] >= c[1][1] ? vec2(1, 0) : vec2(0, 1));
+    el.l2 = max(el.l2, el.l1 / (MAX_ANISOTROPY * MAX_ANISOTROPY));
+    return el;
+}
+
+// The variance per axis (level-0 texels²) that a trilinear lookup at
+// fractional level λ = L + w adds to level 0's bilinear one: the mixture of
+// the two levels' kernels, (1 - w) V(L) + w V(L + 1), with V(L) = (4^L - 1)/4
+// (box (4^L - 1)/12 plus tent 4^L/6, less level 0's tent 1/6). Its inverse
+// gives the level whose kernel has variance v.
+float trilinearLevel(float v) {
+    float x = 4.0 * max(v, 0.0) + 1.0;  // 4^L (1 + 3w)
+    float l = floor(0.5 * log2(x));
+    return l + clamp((x / exp2(2.0 * l) - 1.0) / 3.0, 0.0, 1.0);
+}
+
+// Most trilinear probes along the major axis of one lookup.
+const int MAX_PROBES = 8;
+
+// The fast lookup (after Feline, McCormack et al., "Feline: Fast Elliptical
+// Lines for Anisotropic Texture Mapping", SIGGRAPH 1999): trilinear probes
+// whose isotropic kernel has the ellipse's minor variance l2, spread along
+// the major axis with Gaussian weights whose variance is the rest, l1 - l2,
+// exactly (the offsets are rescaled to it). One probe for a near-isotropic
+// footprint; two or more, spaced at most two probe σ apart (the sum's ripple
+// stays near 1 %), up to MAX_PROBES; beyond that the minor axis widens (the
+// probes' level rises) until MAX_PROBES cover the major axis. The probes
+// match the Gaussian's mean and covariance, not its shape.
+vec4 probeLookup(uint index, Footprint fp) {
+    vec2 s0 = vec2(textureSize(textures[nonuniformEXT(index)], 0));
+    float last = float(textureQueryLevels(textures[nonuniformEXT(index)]) - 1);
+    TexelEllipse el = texelEllipse(fp, s0);
+    float minor = el.l2;
+    float rest = el.l1 - minor;
+    if (rest <= 0.05 * (minor + 1.0 / 6.0)) {
+        return textureLod(textures[nonuniformEXT(index)], fp.uv, min(trilinearLevel(el.l1), last));
+    }
+    // Probe σ (with the reconstruction's own) against the rest's σ: probes
+    // spaced at most 2 probe σ apart over ±2 σ of the rest.
+    float probeSigma = sqrt(minor + 1.0 / 6.0);
+    int n = max(2, int(ceil(2.0 * sqrt(rest) / probeSigma)) + 1);
+    if (n > MAX_PROBES) {
+        // Widen the minor axis until MAX_PROBES suffice: 2 √(l1 - m) / √(m + 1/6) <= MAX_PROBES - 1.
+        float k = 0.25 * float((MAX_PROBES - 1) * (MAX_PROBES - 1));
+        minor = max(minor, (el.l1 - k / 6.0) / (1.0 + k));
+        rest = el.l1 - minor;
+        n = MAX_PROBES;
+    }
+    float lod = min(trilinearLevel(minor), last);
+    float sigmaRest = sqrt(rest);
+    float spacing = 4.0 * sigmaRest / float(n - 1);
+    // Gaussian weights on the offsets, then the offsets scaled so that the
+    // weighted variance is exactly `rest` (with two probes: ±σ, weights ½).
+    float sw = 0.0, sv = 0.0;
+    for (int k = 0; k < n; ++k) {
+        float o = (float(k) - 0.5 * float(n - 1)) * spacing;
+        float w = exp(-0.5 * o * o / rest);
+        sw += w;
+        sv += w * o * o;
+    }
+    float stretch = sqrt(rest * sw / max(sv, 1e-30));
+    vec2 step = el.e1 / s0 * (spacing * stretch);
+    vec4 sum = vec4(0.0);
+    for (int k = 0; k < n; ++k) {
+        float t = float(k) - 0.5 * float(n - 1);
+        float o = t * spacing;
+        float w = exp(-0.5 * o * o / rest);
+        sum += w * textureLod(textures[nonuniformEXT(index)], fp.uv + t * step, lod);
+    }
+    return sum / sw;
+}
+
+// The reference lookup (`--lookup ewa`): elliptical weighted averaging
+// (P. Heckbert, "Fundamentals of Texture Mapping and Image Warping", 1989)
+// of the texels of one mip level with a Gaussian whose covariance is the
+// footprint's, plus level 0's reconstruction (1/6), less the level's own box
+// ((4^L - 1)/12): a weighted sum of a level's texels approximates the
+// convolution of their box-filtered signal with the weights once the
+// weights' σ is a few texels of that level (two, which picks the level). The
+// level rises further until the 3σ ellipse holds at most MAX_TAPS texels
+// (then the minor axis blurs more than asked); at most the last level.
 vec4 ewaLookup(uint index, Footprint fp) {
     ivec2 size0 = textureSize(textures[nonuniformEXT(index)], 0);
     int levels = textureQueryLevels(textures[nonuniformEXT(index)]);
     vec2 s0 = vec2(size0);
-    // Covariance of the footprint in level-0 texels.
-    vec2 a1 = fp.axis1 * s0, a2 = fp.axis2 * s0;
-    mat2 c = outerProduct(a1, a1) + outerProduct(a2, a2);
-    // Eigen-decomposition of the symmetric 2x2 matrix.
-    float tr = c[0][0] + c[1][1];
-    float det = c[0][0] * c[1][1] - c[0][1] * c[1][0];
-    float disc = sqrt(max(0.0, 0.25 * tr * tr - det));
-    float l1 = 0.5 * tr + disc, l2 = max(0.5 * tr - disc, 0.0);
-    vec2 e1 = abs(c[0][1]) > 1e-20 ? normalize(vec2(l1 - c[1][1], c[0][1])) : (c[0][0] >= c[1][1] ? vec2(1, 0) : vec2(0, 1));
-    vec2 e2 = vec2(-e1.y, e1.x);
-    // Bound the anisotropy by widening the minor axis.
-    l2 = max(l2, l1 / (MAX_ANISOTROPY * MAX_ANISOTROPY));
-    float sigmaMinor = sqrt(l2), sigmaMajor = sqrt(l1);
-    // The level where the minor axis spans about two texels (one more would
-    // add the level's own blur, a box of 2^level texels and the σ = ½ texel
-    // reconstruction, in a proportion that visibly over-blurs), raised until
-    // the 3σ ellipse holds at most MAX_TAPS texels; at most the last level.
+    TexelEllipse el = texelEllipse(fp, s0);
+    vec2 e2 = vec2(-el.e1.y, el.e1.x);
     float last = float(levels - 1);
-    float level = clamp(floor(log2(max(sigmaMinor, 1e-8))) - 1.0, 0.0, last);
-    while (level < last && 28.3 * sigmaMajor * sigmaMinor / exp2(2.0 * level) > MAX_TAPS) level += 1.0;
+    // 4^L · 49/12 <= l2 + 1/4: the weights' σ (l2 + 1/6 - (4^L - 1)/12) at
+    // least two texels of the level, 2^(L+1).
+    float level = clamp(floor(0.5 * log2(max((el.l2 + 0.25) * 12.0 / 49.0, 1e-8))), 0.0, last);
+    while (level < last && 28.3 * sqrt((el.l1 + 0.25) * (el.l2 + 0.25)) / exp2(2.0 * level) > MAX_TAPS) level += 1.0;
     int li = int(level);
     ivec2 size = max(size0 >> li, ivec2(1));
     if (size == ivec2(1)) return texelFetch(textures[nonuniformEXT(index)], ivec2(0), li);
     float scale = float(size.x) / s0.x;  // level texels per level-0 texel (square levels)
-    // Covariance at this level, plus the reconstruction filter (σ = 1/2 texel).
-    mat2 cl = (l1 * outerProduct(e1, e1) + l2 * outerProduct(e2, e2)) * (scale * scale) + mat2(0.25);
+    float box = (exp2(2.0 * level) - 1.0) / 12.0;
+    float floorVar = 0.25 * exp2(2.0 * level);  // at least ½ texel of the level
+    float w1 = max(el.l1 + 1.0 / 6.0 - box, floorVar), w2 = max(el.l2 + 1.0 / 6.0 - box, floorVar);
+    mat2 cl = (w1 * outerProduct(el.e1, el.e1) + w2 * outerProduct(e2, e2)) * (scale * scale);
     mat2 inv = inverse(cl);
     vec2 centre = fp.uv * vec2(size) - 0.5;
     vec2 radius = 3.0 * sqrt(vec2(cl[0][0], cl[1][1]));

@@ -1,6 +1,6 @@
 #version 460
-// Filtered texture lookups on footprints given by the host: the GPU side of
-// the EWA and LEAN tests (tests/texfilter_gpu.rs), which compare them with
+// Filtered texture lookups on footprints given by the host (EWA or the
+// trilinear probes): the GPU side of the lookup and LEAN tests (tests/texfilter_gpu.rs), which compare them with
 // analytic averages and with the slope variance measured on the CPU.
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_EXT_nonuniform_qualifier : require
@@ -12,6 +12,9 @@ layout(local_size_x = PROBE_GROUP) in;
 layout(set = 0, binding = 0) uniform sampler2D textures[MAX_TEXTURES];
 
 #include "texfilter.glsl"
+
+// Specialisation constant: LOOKUP_PROBES or LOOKUP_EWA.
+layout(constant_id = 0) const uint LOOKUP_MODE = LOOKUP_EWA;
 
 struct TexQuery {
     uint texture;
@@ -44,7 +47,7 @@ void main() {
     fp.axis1 = q.axis1;
     fp.axis2 = q.axis2;
     TexResult r;
-    r.value = ewaLookup(q.texture, fp);
+    r.value = LOOKUP_MODE == LOOKUP_EWA ? ewaLookup(q.texture, fp) : probeLookup(q.texture, fp);
     r.alpha = leanAlpha(q.alpha, r.value);
     r.pad = uint[3](0u, 0u, 0u);
     results[i] = r;

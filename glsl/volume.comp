@@ -2,7 +2,7 @@
 // The volumetric-lighting pass (paper section 3): light scattered once by
 // the fog toward the camera from each positional light (point, sphere,
 // rect), with shadows: light shafts. For each pixel, camera rays jittered
-// over the pixel run from the camera to the first surface (or to a sphere or
+// over the pixel filter (the render pass's Gaussian) run from the camera to the first surface (or to a sphere or
 // rect light in front of it, or on to infinity); on each, per light, one
 // point by equiangular sampling (media.glsl: its density follows the
 // light's 1/r², so the noise does not grow near a small bright light,
@@ -116,9 +116,10 @@ void main() {
     vec3 sum = vec3(0.0);
     uint side = max(uint(sqrt(float(pc.samples))), 1u);
     for (uint s = 0u; s < pc.samples; ++s) {
-        // Stratified over the pixel within a dispatch (side x side strata, then random).
-        vec2 jitter = s < side * side ? (vec2(s % side, s / side) + rand2(rng)) / float(side) : rand2(rng);
-        vec3 d = cameraRay(vec2(pix) + jitter);
+        // Stratified within a dispatch (side x side strata, then random),
+        // taken to the pixel filter (the render pass's Gaussian).
+        vec2 u = s < side * side ? (vec2(s % side, s / side) + rand2(rng)) / float(side) : rand2(rng);
+        vec3 d = cameraRay(vec2(pix) + 0.5 + gaussianPixelOffset(u, frame.pixelSigma));
         SceneHit h = traceScene(frame.eye, d, 0.0, 1e30);
         float tl;
         firstLightHit(frame.eye, d, h.object == NO_HIT ? 1e30 : h.t, frame.lightCount, tl);

@@ -128,8 +128,15 @@ struct CompareArgs {
 
 #[derive(Parser, Debug)]
 struct FilterBenchArgs {
-    /// Scene files (default: the two figure-1 scenes).
-    #[arg(default_values = ["scenes/figure1_left.toml", "scenes/figure1_right.toml"])]
+    /// Scene files (default: the three texture-dominated scenes and the two
+    /// figure-1 scenes, lighting-dominated controls).
+    #[arg(default_values = [
+        "scenes/glints.toml",
+        "scenes/glossy_window.toml",
+        "scenes/anisotropic.toml",
+        "scenes/figure1_left.toml",
+        "scenes/figure1_right.toml",
+    ])]
     scenes: Vec<PathBuf>,
     /// Output folder (created if missing); references are cached in its `cache/`.
     #[arg(short, long, default_value = "results/filtering")]
@@ -140,31 +147,52 @@ struct FilterBenchArgs {
     /// Image height.
     #[arg(long, default_value_t = 192, value_parser = clap::value_parser!(u32).range(8..=4096))]
     height: u32,
-    /// Samples per pixel of the reference (filtering `none`).
-    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    /// Samples per pixel of the reference (filtering `none`), rendered as two
+    /// halves with different seeds so that its own noise is measured and
+    /// subtracted from every error.
+    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(2..=1_000_000))]
     reference_spp: u32,
     /// Each mode renders at 1, 2, 4, … up to this many samples per pixel.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
     max_spp: u32,
+    /// Independent renders (seeds) per measured point: the error splits into
+    /// variance (across them) and bias².
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
+    seeds: u32,
+    /// The targets: `none`'s error at these spp (each must be on the spp
+    /// ladder up to --max-spp), comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [16u32, 64])]
+    targets: Vec<u32>,
     /// Frames of the camera pan for temporal stability (0 skips it).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 6)]
     frames: u32,
     /// Samples per pixel of each mode's pan frames.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=65536))]
     frame_spp: u32,
     /// Samples per pixel of the reference pan frames.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     reference_frame_spp: u32,
     /// Camera motion per pan frame, as a fraction of the camera's distance to
     /// its look-at point, along its right vector (0.004 is about a pixel at
     /// the look-at distance for a 192-pixel-high, 40° view).
     #[arg(long, default_value_t = 0.004)]
     pan_step: f64,
-    /// What the renders compute: `full` (the path tracer) or `albedo` (texture
+    /// What the renders compute: `full` (the path tracer), `albedo` (texture
     /// transport alone: the albedo seen directly and through perfect mirrors,
-    /// no lighting; isolates what filtering does from lighting noise).
+    /// no lighting; isolates what filtering does from lighting noise) or
+    /// `glossy-albedo` (the albedo also seen through glossy reflections and
+    /// refractions, their lobes sampled).
     #[arg(long, value_enum, default_value_t = BenchShading::Full)]
     shading: BenchShading,
+    /// The filtered modes' texture lookup: `probes` (trilinear probes along
+    /// the footprint's major axis) or `ewa` (the reference lookup).
+    #[arg(long, value_enum, default_value_t = Lookup::Probes)]
+    lookup: Lookup,
+    /// Render nothing: read the reports earlier runs wrote in the output
+    /// folder for these scenes and write `summary.md` and `headline.json`
+    /// over them.
+    #[arg(long)]
+    summarize_only: bool,
     /// Enable the Khronos validation layer (fails on any error).
     #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     validation: bool,
@@ -177,6 +205,28 @@ enum BenchShading {
     Full,
     /// The albedo seen directly and through perfect mirrors, no lighting.
     Albedo,
+    /// The albedo seen directly and through mirrors, glossy reflections and
+    /// refractions, no lighting.
+    GlossyAlbedo,
+}
+
+/// The filtered modes' texture lookup (`--lookup`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+enum Lookup {
+    /// Trilinear probes along the footprint's major axis.
+    #[default]
+    Probes,
+    /// Elliptical weighted averaging over one mip level (the reference lookup).
+    Ewa,
+}
+
+impl Lookup {
+    fn constant(self) -> u32 {
+        match self {
+            Self::Probes => quadray::shader_interface::LOOKUP_PROBES,
+            Self::Ewa => quadray::shader_interface::LOOKUP_EWA,
+        }
+    }
 }
 
 /// Image size and seed overrides of `render` and `outliers`.
@@ -703,6 +753,8 @@ fn filter_bench(args: FilterBenchArgs) -> Result<()> {
         height: args.height,
         reference_spp: args.reference_spp,
         max_spp: args.max_spp,
+        seeds: args.seeds,
+        targets: args.targets,
         frames: args.frames,
         frame_spp: args.frame_spp,
         reference_frame_spp: args.reference_frame_spp,
@@ -710,25 +762,27 @@ fn filter_bench(args: FilterBenchArgs) -> Result<()> {
         shading: match args.shading {
             BenchShading::Full => quadray::shader_interface::SHADING_FULL,
             BenchShading::Albedo => quadray::shader_interface::SHADING_MIRRORED_ALBEDO,
+            BenchShading::GlossyAlbedo => quadray::shader_interface::SHADING_GLOSSY_ALBEDO,
         },
+        lookup: args.lookup.constant(),
         command,
     };
+    if args.summarize_only {
+        quadray::filter_bench::summarize(&config)?;
+        return Ok(());
+    }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
     let reports = quadray::filter_bench::run(&ctx, &config)?;
     for r in &reports {
-        for h in &r.headline {
-            eprintln!(
-                "{}: {:>10} reaches FLIP {:.4} (none @ {} spp) in {}",
-                r.scene,
-                h.mode,
-                r.target_flip,
-                r.target_spp,
-                h.seconds_to_target.map_or("-- (not reached)".into(), |t| format!(
-                    "{t:.3} s: {:.2}x none",
-                    h.speedup_over_none.unwrap_or(0.0)
-                ))
-            );
+        for e in quadray::filter_bench::headline_entries(r) {
+            let speedups = e
+                .speedup_vs_none
+                .iter()
+                .map(|(m, v)| format!("{m} {}", v.map_or("not reached".into(), |v| format!("{v:.2}x"))))
+                .collect::<Vec<_>>()
+                .join(", ");
+            eprintln!("{}: texture share {:.3}, target {}: {speedups}", e.scene, e.texture_share, e.target);
         }
     }
     drop(ctx);

@@ -82,6 +82,11 @@ pub const SHADING_NONE: u32 = 1;
 /// many samples per pixel and no filtering it is the exact pixel average of
 /// the textures seen directly and in mirrors (the filtering tests).
 pub const SHADING_MIRRORED_ALBEDO: u32 = 2;
+/// Shading mode: the albedo of the first diffuse hit, seen through mirrors,
+/// glossy conductors and dielectrics (their lobes sampled, the path's weight
+/// times that albedo); no lighting. Textures seen directly and in glossy
+/// reflections: the prefiltering benchmark's `--shading glossy-albedo`.
+pub const SHADING_GLOSSY_ALBEDO: u32 = 3;
 /// Texture filtering: bilinear lookups of mip level 0 (with many samples per
 /// pixel, the brute-force reference).
 pub const FILTER_NONE: u32 = 0;
@@ -90,6 +95,12 @@ pub const FILTER_RAY_CONES: u32 = 1;
 /// Texture filtering: covariance footprints carried along the path (the
 /// paper's method), with EWA lookups.
 pub const FILTER_COVARIANCE: u32 = 2;
+/// Texture lookup of the filtered modes: trilinear probes along the
+/// footprint's major axis (texfilter.glsl, probeLookup; the default).
+pub const LOOKUP_PROBES: u32 = 0;
+/// Texture lookup of the filtered modes: elliptical weighted averaging over
+/// one mip level (texfilter.glsl, ewaLookup; the reference lookup).
+pub const LOOKUP_EWA: u32 = 1;
 /// Descriptor binding of the caustic rays' landings (caustic passes).
 pub const BINDING_CAUSTIC_RAYS: u32 = 8;
 /// Descriptor binding of the G-buffer of pixel-centre receivers (G-buffer

@@ -28,6 +28,7 @@ const BRUTE_FORCE: RenderVariant = RenderVariant {
     caustics: false,
     volume: false,
     record_path: false,
+    lookup: quadray::shader_interface::LOOKUP_PROBES,
 };
 
 fn upload(ctx: &Context, cmds: &mut Commands, scene: &Scene) -> GpuScene {

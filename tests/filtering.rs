@@ -17,7 +17,7 @@ use quadray::geometry::{Aabb, FunctionalObject, Quadric};
 use quadray::passes::RenderVariant;
 use quadray::scene::{Material, MaterialMaps, UvMapping, UvSettings};
 use quadray::shader_interface::{
-    FILTER_COVARIANCE, FILTER_NONE, FILTER_RAY_CONES, SHADING_MIRRORED_ALBEDO, SHADING_NONE,
+    FILTER_COVARIANCE, FILTER_NONE, FILTER_RAY_CONES, SHADING_GLOSSY_ALBEDO, SHADING_MIRRORED_ALBEDO, SHADING_NONE,
 };
 
 const A: f32 = 0.9;
@@ -265,4 +265,86 @@ fn footprints_through_a_curved_mirror_average_the_reflected_checker() {
     assert!(errors[0] > 0.2, "the unfiltered 1-spp render should alias in the mirror");
     assert!(errors[1] <= MIRROR_RMS_TOLERANCE, "ray cones through the mirror: {}", errors[1]);
     assert!(errors[2] <= MIRROR_RMS_TOLERANCE, "covariance through the mirror: {}", errors[2]);
+}
+
+/// Samples per pixel of each half of the glossy test's reference.
+const GLOSSY_REFERENCE_HALF_SPP: u32 = 2048;
+/// Independent 16-spp renders averaged per filtered mode in the glossy test.
+const GLOSSY_SEEDS: u32 = 16;
+/// Standard deviations of the test statistic allowed above its expectation.
+const GLOSSY_Z: f64 = 5.0;
+/// Each 4x more samples must at least halve the filtered error (an unbiased
+/// estimate's error falls 4x; a plateau keeps it).
+const GLOSSY_FALL: f64 = 0.5;
+
+/// The prefiltering bias is gone: albedo-only (the albedo seen directly and
+/// through a glossy reflector, `SHADING_GLOSSY_ALBEDO`) on a fine checker
+/// wall and a glossy floor (scenes/tests/glossy_reflector.toml). For each
+/// filtered mode, the mean of `GLOSSY_SEEDS` independent 16-spp renders
+/// equals the unfiltered 4096-spp reference within their noise: the sum over
+/// pixels and channels of (mean − reference)² over the sum of its expected
+/// value with no bias (the mean's variance, from the seeds, plus the
+/// reference's, from its two halves) is at most 1 + `GLOSSY_Z` standard
+/// deviations of that ratio. And its relative MSE (the reference's variance
+/// subtracted) keeps falling from 16 to 64 to 256 spp, by at least
+/// `GLOSSY_FALL` each time.
+#[test]
+fn filtered_albedo_through_a_glossy_reflector_converges_to_the_reference() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tests/glossy_reflector.toml");
+    let scene = quadray::scene::load_scene(&path).unwrap();
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let render = |filter: u32, spp: u32, seed: u32| -> Vec<f64> {
+        let mut s = scene.clone();
+        s.image.spp = spp;
+        s.image.seed = seed;
+        let variant = RenderVariant { filter, shading: SHADING_GLOSSY_ALBEDO, ..Default::default() };
+        let out = common::finite(quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap());
+        out.radiance.iter().flatten().map(|&v| f64::from(v)).collect()
+    };
+    let (a, b) =
+        (render(FILTER_NONE, GLOSSY_REFERENCE_HALF_SPP, 1001), render(FILTER_NONE, GLOSSY_REFERENCE_HALF_SPP, 1002));
+    let reference: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.5 * (x + y)).collect();
+    let reference_variance: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.25 * (x - y).powi(2)).collect();
+    let relative_error = |img: &[f64]| -> f64 {
+        let sum: f64 = img
+            .iter()
+            .zip(&reference)
+            .zip(&reference_variance)
+            .map(|((t, r), v)| ((t - r).powi(2) - v) / (r * r + quadray::metrics::RELATIVE_MSE_EPSILON))
+            .sum();
+        sum / img.len() as f64
+    };
+    let mut results = Vec::new();
+    for (name, filter) in [("ray-cones", FILTER_RAY_CONES), ("covariance", FILTER_COVARIANCE)] {
+        let renders: Vec<Vec<f64>> = (0..GLOSSY_SEEDS).map(|k| render(filter, 16, 10 + k)).collect();
+        let k = f64::from(GLOSSY_SEEDS);
+        let (mut d2, mut expected, mut expected_sq) = (0.0, 0.0, 0.0);
+        for i in 0..reference.len() {
+            let mean = renders.iter().map(|r| r[i]).sum::<f64>() / k;
+            let var = renders.iter().map(|r| (r[i] - mean).powi(2)).sum::<f64>() / (k - 1.0);
+            let e = var / k + reference_variance[i];
+            d2 += (mean - reference[i]).powi(2);
+            expected += e;
+            expected_sq += e * e;
+        }
+        let ratio = d2 / expected;
+        // For Gaussian noise (mean − ref)² has variance 2e²: the ratio's σ.
+        let sigma = (2.0 * expected_sq).sqrt() / expected;
+        let errors: Vec<f64> =
+            [16, 64, 256].iter().map(|&spp| relative_error(&render(filter, spp, 500 + spp))).collect();
+        println!(
+            "{name}: squared bias of the {GLOSSY_SEEDS}-seed mean over its expected noise {ratio:.3} (allowed 1 + \
+             {GLOSSY_Z} x {sigma:.3}); relative MSE at 16, 64, 256 spp: {:.2e}, {:.2e}, {:.2e}",
+            errors[0], errors[1], errors[2]
+        );
+        results.push((name, ratio, sigma, errors));
+    }
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+    for (name, ratio, sigma, errors) in results {
+        assert!(ratio <= 1.0 + GLOSSY_Z * sigma, "{name}: the filtered mean is biased ({ratio:.3})");
+        assert!(errors[1] <= GLOSSY_FALL * errors[0], "{name}: the error stalls from 16 to 64 spp: {errors:?}");
+        assert!(errors[2] <= GLOSSY_FALL * errors[1], "{name}: the error stalls from 64 to 256 spp: {errors:?}");
+    }
 }

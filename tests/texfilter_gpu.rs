@@ -1,10 +1,11 @@
 //! The shader's texture filters (glsl/texfilter.glsl) on footprints given
 //! directly, against analytic answers:
 //!
-//! - EWA over the mip chain of a checkerboard against the exact average of
-//!   the (continuous) checkerboard under the same Gaussian footprint,
-//!   computed on the CPU by quadrature, for isotropic, anisotropic and
-//!   rotated footprints from a tenth of a texel to many checker cells;
+//! - EWA (the reference lookup) and the trilinear probes (the default) over
+//!   the mip chain of a checkerboard against the exact average of the
+//!   (continuous) checkerboard under the same Gaussian footprint, computed
+//!   on the CPU by quadrature, for isotropic, anisotropic and rotated
+//!   footprints from a tenth of a texel to many checker cells;
 //! - LEAN filtering of a normal map of random bumps: the roughness after
 //!   filtering to the coarsest level against the one that the slope variance
 //!   measured on the CPU (from the height field, in f64) predicts.
@@ -16,6 +17,7 @@ use quadray::geometry::{FunctionalObject, Quadric};
 use quadray::passes::gpu::GpuTexQuery;
 use quadray::passes::{GpuScene, TexProbePass};
 use quadray::scene::{Material, MaterialMaps};
+use quadray::shader_interface::{LOOKUP_EWA, LOOKUP_PROBES};
 use quadray::texture::{bump_heights, checker, lean, normals_from_heights, TextureImage};
 use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
@@ -27,14 +29,15 @@ const CELLS: u32 = 16;
 
 /// EWA against the exact Gaussian average, |error| in units of the checker's
 /// contrast (1), for isotropic footprints whose σ is at least one texel. EWA
-/// adds the mip level's box filter and its own reconstruction filter (σ = ½
-/// texel of the level) to the footprint, which blurs a little more than the
-/// exact average where the footprint is about a checker cell wide.
-const EWA_TOLERANCE: f64 = 0.04;
-/// Anisotropic footprints: the tap budget (MAX_TAPS = 64 texels in the 3σ
-/// ellipse) forces a coarser level for long ellipses, whose blur widens the
-/// minor axis.
-const EWA_ANISOTROPIC_TOLERANCE: f64 = 0.08;
+/// asks each mip level for the footprint less the level's own box filter,
+/// plus level 0's bilinear reconstruction (what `none` reads), with Gaussian
+/// weights at least two texels of the level wide; against the continuous
+/// checker that reconstruction remains (measured: at most 0.0071).
+const EWA_TOLERANCE: f64 = 0.01;
+/// Anisotropic footprints (measured: at most 0.0069): the tap budget
+/// (MAX_TAPS = 1024 texels in the 3σ ellipse) would force a coarser level,
+/// whose blur widens the minor axis, only for longer ellipses than these.
+const EWA_ANISOTROPIC_TOLERANCE: f64 = 0.01;
 /// Footprints below a texel: the filter reconstructs the texels (σ = ½
 /// texel) instead of point sampling the continuous checker, so near the cell
 /// edges the result differs by up to the texel's own blur.
@@ -108,12 +111,8 @@ fn query(texture: u32, uv: DVec2, a1: DVec2, a2: DVec2, alpha: f32) -> GpuTexQue
     }
 }
 
-#[test]
-fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
-    let scene = texture_scene(
-        vec![checker(SIZE, CELLS, [1.0, 0.0, 0.0], [0.0, 0.0, 0.0])],
-        MaterialMaps { albedo: Some(0), ..Default::default() },
-    );
+/// The checker cases of the lookup tests: (minor σ, anisotropy, uv, axes).
+fn checker_cases() -> Vec<(f64, f64, DVec2, DVec2, DVec2)> {
     let texel = 1.0 / SIZE as f64;
     // Random centres and angles in each class but the wide one.
     let mut rng = Pcg64::seed_from_u64(11);
@@ -134,24 +133,35 @@ fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
         let a = WIDE_SIGMA * texel;
         cases.push((WIDE_SIGMA, 1.0, uv, DVec2::new(a, 0.0), DVec2::new(0.0, a)));
     }
+    cases
+}
+
+/// Runs `lookup` (LOOKUP_EWA or LOOKUP_PROBES) on the checker cases and
+/// checks each class's largest |error| against `bound(σ, anisotropy)`.
+fn check_lookup_on_the_checker(name: &str, lookup: u32, bound: impl Fn(f64, f64) -> f64) {
+    let scene = texture_scene(
+        vec![checker(SIZE, CELLS, [1.0, 0.0, 0.0], [0.0, 0.0, 0.0])],
+        MaterialMaps { albedo: Some(0), ..Default::default() },
+    );
+    let cases = checker_cases();
     let queries: Vec<_> = cases.iter().map(|&(_, _, uv, a1, a2)| query(0, uv, a1, a2, 0.0)).collect();
 
     let ctx = common::context();
     let counters = ctx.counters();
     let mut cmds = Commands::new(&ctx.device).unwrap();
     let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
-    let results = TexProbePass::new(&ctx.device, &gpu, &queries).unwrap().run(&mut cmds).unwrap();
+    let results = TexProbePass::with_lookup(&ctx.device, &gpu, &queries, lookup).unwrap().run(&mut cmds).unwrap();
     drop(gpu);
     drop(cmds);
     drop(ctx);
     common::assert_no_validation_errors(&counters);
 
     println!(
-        "{:>12} {:>8} {:>6} {:>12} {:>12} {:>10}",
+        "{name}: {:>12} {:>8} {:>6} {:>12} {:>12} {:>10}",
         "minor σ (tx)", "aniso", "cases", "max |error|", "mean |err|", "bound"
     );
     let mut failures = Vec::new();
-    let mut class = |sigma: f64, aniso: f64| {
+    for &(sigma, aniso) in &EWA_CLASSES {
         let (mut max, mut sum, mut n) = (0.0f64, 0.0, 0);
         for (k, &(s, a, uv, a1, a2)) in cases.iter().enumerate() {
             if s != sigma || a != aniso {
@@ -165,7 +175,19 @@ fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
             sum += err;
             n += 1;
         }
-        let bound = if sigma >= WIDE_SIGMA {
+        let bound = bound(sigma, aniso);
+        println!("{name}: {sigma:>12} {aniso:>8} {n:>6} {max:>12.4} {:>12.4} {bound:>10}", sum / n as f64);
+        if max > bound {
+            failures.push(format!("σ {sigma} texels, anisotropy {aniso}: {max:.4} > {bound}"));
+        }
+    }
+    assert!(failures.is_empty(), "{name} beyond its bounds: {failures:?}");
+}
+
+#[test]
+fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
+    check_lookup_on_the_checker("EWA", LOOKUP_EWA, |sigma, aniso| {
+        if sigma >= WIDE_SIGMA {
             EWA_WIDE_TOLERANCE
         } else if sigma < 1.0 {
             EWA_SUBTEXEL_TOLERANCE
@@ -173,16 +195,110 @@ fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
             EWA_ANISOTROPIC_TOLERANCE
         } else {
             EWA_TOLERANCE
+        }
+    });
+}
+
+/// Jitter points per axis of the probes test: a midpoint grid over ±4σ.
+const JITTER_GRID: usize = 12;
+/// Trilinear probes averaged over the jitter, against the exact Gaussian
+/// average of the checker under jitter ⊛ footprint, |error| in units of the
+/// contrast, for footprints of 16 texels or more and for the anisotropic
+/// classes (measured: at most 0.044).
+const PROBE_TOLERANCE: f64 = 0.05;
+/// The same for isotropic footprints of 1 to 8 texels: a **known residual
+/// bias** of the probe lookup (measured 0.045 – 0.11, mean 0.012 – 0.047).
+/// The level is chosen as if its bilinear tent were a convolution, which it
+/// is in expectation only under jitter wider than a texel of that level;
+/// here the jitter is as wide as the footprint, a fraction of such a texel,
+/// and the checker's edges fall on the level's texel boundaries (the worst
+/// case), so the expectation is blurred less than asked. Bounded here so
+/// that it cannot grow unnoticed; removing it (a finer level and more
+/// probes) is an open item of the prefiltering issue.
+const PROBE_SMALL_FOOTPRINT_BIAS: f64 = 0.12;
+
+/// The trilinear probes (the default lookup) are not shift invariant: a
+/// bilinear lookup reads a texel's own value at its centre and a blend
+/// between texels, so each lookup differs from the Gaussian average by up
+/// to the kernel's shape. What the renderer relies on is their expectation
+/// under the camera jitter: the mean of the lookups over jitter positions
+/// with the footprint's own Gaussian (a `JITTER_GRID`² midpoint grid over
+/// ±4σ) must be the exact average of the checker under the Gaussian of twice
+/// that covariance (jitter ⊛ footprint), within `PROBE_TOLERANCE`, on the
+/// footprint classes of the EWA test, but for the known residual bias at
+/// isotropic footprints of 1 to 8 texels (`PROBE_SMALL_FOOTPRINT_BIAS`).
+#[test]
+fn trilinear_probes_average_to_the_exact_gaussian_under_jitter() {
+    let scene = texture_scene(
+        vec![checker(SIZE, CELLS, [1.0, 0.0, 0.0], [0.0, 0.0, 0.0])],
+        MaterialMaps { albedo: Some(0), ..Default::default() },
+    );
+    let cases = checker_cases();
+    let grid: Vec<(f64, f64, f64)> = (0..JITTER_GRID)
+        .flat_map(|i| {
+            (0..JITTER_GRID).map(move |j| {
+                let s = -4.0 + 8.0 * (i as f64 + 0.5) / JITTER_GRID as f64;
+                let t = -4.0 + 8.0 * (j as f64 + 0.5) / JITTER_GRID as f64;
+                (s, t, (-0.5 * (s * s + t * t)).exp())
+            })
+        })
+        .collect();
+    let queries: Vec<_> = cases
+        .iter()
+        .flat_map(|&(_, _, uv, a1, a2)| grid.iter().map(move |&(s, t, _)| query(0, uv + a1 * s + a2 * t, a1, a2, 0.0)))
+        .collect();
+    let ctx = common::context();
+    let counters = ctx.counters();
+    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
+    let results =
+        TexProbePass::with_lookup(&ctx.device, &gpu, &queries, LOOKUP_PROBES).unwrap().run(&mut cmds).unwrap();
+    drop(gpu);
+    drop(cmds);
+    drop(ctx);
+    common::assert_no_validation_errors(&counters);
+
+    let weights: f64 = grid.iter().map(|g| g.2).sum();
+    let root2 = std::f64::consts::SQRT_2;
+    let mut failures = Vec::new();
+    println!(
+        "{:>12} {:>8} {:>6} {:>12} {:>12} {:>10}",
+        "minor σ (tx)", "aniso", "cases", "max |error|", "mean |err|", "bound"
+    );
+    for &(sigma, aniso) in &EWA_CLASSES {
+        let (mut max, mut sum, mut n) = (0.0f64, 0.0, 0);
+        for (k, &(s, a, uv, a1, a2)) in cases.iter().enumerate() {
+            if s != sigma || a != aniso {
+                continue;
+            }
+            let mean: f64 = grid
+                .iter()
+                .enumerate()
+                .map(|(g, &(_, _, w))| {
+                    let v = results[k * grid.len() + g].value[0] as f64;
+                    assert!(v.is_finite(), "non-finite lookup");
+                    w * v
+                })
+                .sum::<f64>()
+                / weights;
+            let err = (mean - exact_average(uv, a1 * root2, a2 * root2)).abs();
+            max = max.max(err);
+            sum += err;
+            n += 1;
+        }
+        let bound = if sigma < 1.0 {
+            EWA_SUBTEXEL_TOLERANCE
+        } else if aniso == 1.0 && sigma <= 8.0 {
+            PROBE_SMALL_FOOTPRINT_BIAS
+        } else {
+            PROBE_TOLERANCE
         };
         println!("{sigma:>12} {aniso:>8} {n:>6} {max:>12.4} {:>12.4} {bound:>10}", sum / n as f64);
         if max > bound {
             failures.push(format!("σ {sigma} texels, anisotropy {aniso}: {max:.4} > {bound}"));
         }
-    };
-    for &(sigma, aniso) in &EWA_CLASSES {
-        class(sigma, aniso);
     }
-    assert!(failures.is_empty(), "EWA beyond its bounds: {failures:?}");
+    assert!(failures.is_empty(), "probes under jitter beyond their bounds: {failures:?}");
 }
 
 /// Per-axis slope variance of the normal map `normals_from_heights(h, k)`,

@@ -326,6 +326,11 @@ pub struct GpuFrame {
     pub env_scale: f32,
     /// The medium outside the objects (fog; density 0: none).
     pub fog: GpuMedium,
+    /// The Gaussian pixel filter's σ in pixels ([`PIXEL_FILTER_SIGMA`](crate::passes::render::PIXEL_FILTER_SIGMA)).
+    pub pixel_sigma: f32,
+    /// The share of the pixel filter's variance that the filtered modes'
+    /// footprints carry ([`footprint_fraction`](crate::passes::render::footprint_fraction)).
+    pub footprint_fraction: f32,
 }
 
 /// `Aov` in render.comp.
@@ -537,7 +542,7 @@ const _: () = {
     assert!(std::mem::size_of::<GpuMaterial>() == 112);
     assert!(std::mem::size_of::<GpuMedium>() == 20);
     assert!(std::mem::size_of::<GpuLight>() == 56);
-    assert!(std::mem::size_of::<GpuFrame>() == 116);
+    assert!(std::mem::size_of::<GpuFrame>() == 124);
     assert!(std::mem::size_of::<GpuAov>() == 32);
     assert!(std::mem::size_of::<GpuRay>() == 32);
     assert!(std::mem::size_of::<GpuHit>() == 32);

@@ -10,7 +10,8 @@ use super::scene_gpu::{camera_basis, GpuScene};
 use super::volume::VolumeLight;
 use crate::scene::Scene;
 use crate::shader_interface::{
-    FILTER_NONE, INTERSECT_FULL, MAX_TEXTURES, NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP, SHADING_FULL,
+    FILTER_NONE, INTERSECT_FULL, LOOKUP_PROBES, MAX_TEXTURES, NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP,
+    SHADING_FULL,
 };
 use crate::vk::{
     full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
@@ -104,6 +105,9 @@ pub struct RenderVariant {
     /// Record the events of one pixel's path ([`Renderer::trace_path`]);
     /// false compiles the recording out.
     pub record_path: bool,
+    /// The filtered modes' texture lookup: `LOOKUP_PROBES` (the default) or
+    /// `LOOKUP_EWA` (the reference lookup).
+    pub lookup: u32,
 }
 
 impl Default for RenderVariant {
@@ -115,6 +119,7 @@ impl Default for RenderVariant {
             caustics: true,
             volume: true,
             record_path: false,
+            lookup: LOOKUP_PROBES,
         }
     }
 }
@@ -140,8 +145,33 @@ pub fn render(
     Ok(out)
 }
 
-/// The camera and image parameters of the shaders' `Frame` block.
-fn gpu_frame(scene: &Scene, gpu: &GpuScene, width: u32, height: u32) -> GpuFrame {
+/// The pixel filter of every mode and of the reference: a Gaussian of this
+/// σ, in pixels (pbrt-v4's default Gaussian filter has the same σ). The
+/// camera rays sample it (render.comp, cameraJitter); the filtered modes
+/// split it between jitter and footprint.
+pub const PIXEL_FILTER_SIGMA: f32 = 0.5;
+
+/// The largest share of the pixel filter's variance that a filtered mode's
+/// footprint carries (at one sample per pixel); the rest is jitter, which
+/// antialiases what texture filtering cannot (object edges, shading).
+pub const FOOTPRINT_FRACTION_MAX: f32 = 0.75;
+
+/// The share of the pixel filter's variance that the filtered modes'
+/// footprints carry at `spp` samples per pixel: 1/√spp, at most
+/// [`FOOTPRINT_FRACTION_MAX`]. Any share in [0, 1] leaves the estimate
+/// unbiased where the texture mapping is locally affine (jitter ⊛ footprint
+/// is the pixel filter); shrinking it with the sample count (as pbrt scales
+/// its ray differentials by max(1/8, 1/√spp)) makes the error that
+/// filtering leaves elsewhere (object edges, curved mappings, LEAN's
+/// approximation of a glossy lobe) vanish as samples grow, at the rate of
+/// the noise.
+pub fn footprint_fraction(spp: u32) -> f32 {
+    FOOTPRINT_FRACTION_MAX.min(1.0 / (spp.max(1) as f32).sqrt())
+}
+
+/// The camera and image parameters of the shaders' `Frame` block, for a
+/// render of `spp` samples per pixel.
+fn gpu_frame(scene: &Scene, gpu: &GpuScene, width: u32, height: u32, spp: u32) -> GpuFrame {
     let [eye, forward, right, up] = camera_basis(scene, width, height);
     GpuFrame {
         // Relative to the GPU frame's origin (the camera, for renders).
@@ -160,6 +190,10 @@ fn gpu_frame(scene: &Scene, gpu: &GpuScene, width: u32, height: u32) -> GpuFrame
         env_height: gpu.environment.map_or(0, |e| e.2),
         env_scale: gpu.environment.map_or(0.0, |e| e.3),
         fog: GpuMedium::from(scene.fog.as_ref()),
+        pixel_sigma: PIXEL_FILTER_SIGMA,
+        // Without maps there is nothing to filter: every mode jitters over
+        // the whole pixel filter, as `none` does.
+        footprint_fraction: if scene.has_texture_maps() { footprint_fraction(spp) } else { 0.0 },
     }
 }
 
@@ -188,6 +222,8 @@ pub struct Renderer {
     timer: GpuTimer,
     tiles: Vec<[u32; 4]>,
     size: (u32, u32),
+    // The samples per pixel the render was made for (the footprints' share).
+    spp: u32,
     volume_samples: u32,
     samples: u32,
     render_seconds: f64,
@@ -209,7 +245,7 @@ impl Renderer {
         let frame = Buffer::with_data(
             device,
             "frame",
-            &[gpu_frame(scene, gpu, width, height)],
+            &[gpu_frame(scene, gpu, width, height, spp)],
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )?;
         let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant)?;
@@ -305,6 +341,7 @@ impl Renderer {
             timer: GpuTimer::new(device)?,
             tiles,
             size: (width, height),
+            spp,
             volume_samples: scene.volume.samples.saturating_mul(spp),
             samples: 0,
             render_seconds: 0.0,
@@ -319,7 +356,7 @@ impl Renderer {
     /// materials must be those the renderer was built with.
     pub fn set_camera(&mut self, cmds: &mut Commands, gpu: &GpuScene, scene: &Scene) -> Result<(), RenderError> {
         let (width, height) = self.size;
-        self.frame.write(0, bytemuck::bytes_of(&gpu_frame(scene, gpu, width, height)));
+        self.frame.write(0, bytemuck::bytes_of(&gpu_frame(scene, gpu, width, height, self.spp)));
         self.restart(cmds)
     }
 
@@ -509,6 +546,7 @@ fn render_pipeline(
             u32::from(volume),
             u32::from(caustics.is_some_and(|c| c.has_beams)),
             u32::from(variant.record_path),
+            variant.lookup,
         ],
     )?)
 }

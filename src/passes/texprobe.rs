@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use super::gpu::{GpuTexQuery, GpuTexResult, ProbePush};
 use super::scene_gpu::GpuScene;
-use crate::shader_interface::{MAX_TEXTURES, PROBE_GROUP};
+use crate::shader_interface::{LOOKUP_EWA, MAX_TEXTURES, PROBE_GROUP};
 use crate::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
 use crate::{shaders, RenderError};
 
@@ -22,11 +22,21 @@ pub struct TexProbePass {
 }
 
 impl TexProbePass {
-    /// Uploads `queries` and binds them with the scene's textures.
+    /// Uploads `queries` and binds them with the scene's textures; EWA lookups.
     pub fn new(device: &Arc<Device>, scene: &GpuScene, queries: &[GpuTexQuery]) -> Result<Self, RenderError> {
+        Self::with_lookup(device, scene, queries, LOOKUP_EWA)
+    }
+
+    /// As [`TexProbePass::new`], with the lookup `LOOKUP_EWA` or `LOOKUP_PROBES`.
+    pub fn with_lookup(
+        device: &Arc<Device>,
+        scene: &GpuScene,
+        queries: &[GpuTexQuery],
+        lookup: u32,
+    ) -> Result<Self, RenderError> {
         let kinds = [BindingKind::SampledImages(MAX_TEXTURES), BindingKind::StorageBuffer, BindingKind::StorageBuffer];
         let push_size = std::mem::size_of::<ProbePush>() as u32;
-        let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &kinds, push_size, &[])?;
+        let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &kinds, push_size, &[lookup])?;
         let query_buf = Buffer::with_data(device, "texture queries", queries, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let results = Buffer::new(
             device,

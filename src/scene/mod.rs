@@ -359,6 +359,13 @@ impl Scene {
         self.fog.iter().chain(self.materials.iter().filter_map(|m| m.medium.as_ref())).any(|m| m.density > 0.0)
     }
 
+    /// True when some material has a texture map (an albedo, normal,
+    /// roughness or displacement map): only then do the filtered modes take
+    /// a share of the pixel filter into their footprints.
+    pub fn has_texture_maps(&self) -> bool {
+        self.materials.iter().any(|m| m.maps != MaterialMaps::default())
+    }
+
     /// True when the volume pass has work: volume samples are enabled, and
     /// the scene has fog and a point, sphere or rect light.
     pub fn needs_volume(&self) -> bool {
