@@ -255,8 +255,8 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     let rgb = exr.vec3(["R", "G", "B"]);
 
     // A pixel covers about 2·tan(15°)·5/30 ≈ 0.09 at the sphere; radiance
-    // (jittered inside the pixel) is checked only where the whole pixel
-    // agrees, the AOVs (pixel centre) wherever the ray is not grazing.
+    // (jittered over the pixel filter) is checked only where the pixel's
+    // neighbourhood agrees, the AOVs (pixel centre) wherever the ray is not grazing.
     let pixel = 2.0 * (0.5 * FOV_DEGREES).to_radians().tan() * EYE[2] / HEIGHT as f64;
     let (mut hits, mut misses, mut lit, mut dark) = (0, 0, 0, 0);
     let mut max_depth_error = 0f64;
@@ -285,7 +285,10 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                     assert_eq!(depth[i], f32::INFINITY, "{at}: depth of a miss");
                     assert_eq!(normal[i], [0.0; 3], "{at}: normal of a miss");
                     assert_eq!(albedo[i], [0.0; 3], "{at}: albedo of a miss");
-                    if e.miss_distance > 1.0 + 1.5 * pixel {
+                    // Camera rays are jittered with the Gaussian pixel
+                    // filter (σ = 0.5 px) from 24-bit uniform numbers: at
+                    // most σ·√(−2 ln 2⁻²⁴) = 2.89 px from the pixel's centre.
+                    if e.miss_distance > 1.0 + 3.0 * pixel {
                         let b = luminance(BACKGROUND);
                         assert!(
                             (largest[i] - b).abs() < 1e-6,
@@ -318,7 +321,38 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                     let r2 = dot(to_light, to_light);
                     let cos = dot(n, normalize(to_light));
                     let environment = |k: usize| ALBEDO[k] as f64 * BACKGROUND[k] as f64;
-                    if n[2] > 0.5 && cos > 0.5 {
+                    // A pixel's radiance is checked where its centre and
+                    // the pixel centres 2 px away in x and y fall in the same
+                    // class: the Gaussian jitter (σ = 0.5 px) takes a sample
+                    // beyond 2 px with probability e⁻⁸ = 0.03 %, which moves
+                    // a pixel by under 1 % even at a 20:1 contrast (the
+                    // bounds below are 15 % and 25 %).
+                    let class = |x: usize, y: usize| -> Option<i32> {
+                        let (n, cos) = match expected(x, y, WIDTH, HEIGHT).hit {
+                            Some((_, n)) => (n, dot(n, normalize(sub(LIGHT, n)))),
+                            None => return None,
+                        };
+                        if n[2] > 0.5 && cos > 0.5 {
+                            Some(1)
+                        } else if n[2] > 0.5 && cos < -0.2 {
+                            Some(-1)
+                        } else {
+                            Some(0)
+                        }
+                    };
+                    let near: Vec<Option<i32>> = [(0i64, 0i64), (-2, 0), (2, 0), (0, -2), (0, 2)]
+                        .iter()
+                        .map(|&(dx, dy)| {
+                            let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+                            if nx < 0 || ny < 0 || nx >= WIDTH as i64 || ny >= HEIGHT as i64 {
+                                None
+                            } else {
+                                class(nx as usize, ny as usize)
+                            }
+                        })
+                        .collect();
+                    let agrees = near.iter().all(|c| *c == near[0]);
+                    if agrees && n[2] > 0.5 && cos > 0.5 {
                         lit += 1;
                         for k in 0..3 {
                             let want = ALBEDO[k] as f64 / std::f64::consts::PI * INTENSITY * cos / r2 + environment(k);
@@ -326,7 +360,7 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                             max_lit_error = max_lit_error.max(rel);
                             assert!(rel < 0.15, "{at}: radiance {:?}, Lambert gives {want} in channel {k}", rgb[i]);
                         }
-                    } else if n[2] > 0.5 && cos < -0.2 {
+                    } else if agrees && n[2] > 0.5 && cos < -0.2 {
                         dark += 1;
                         for k in 0..3 {
                             let rel = (rgb[i][k] as f64 - environment(k)).abs() / environment(k);
@@ -344,7 +378,9 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
         100.0 * max_lit_error,
         100.0 * max_dark_error
     );
-    assert!(hits > 200 && misses > 200 && lit > 20 && dark > 20, "the scene should show all cases");
+    // Coverage, not accuracy: the 2-px neighbourhoods above leave 28 lit and
+    // 14 dark pixels at this image size.
+    assert!(hits > 200 && misses > 200 && lit > 20 && dark > 10, "the scene should show all cases");
 
     // The first pixel-centre ray near the image centre (the width and the
     // height are even, so no ray is on the axis).
