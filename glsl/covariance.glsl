@@ -3,9 +3,9 @@
 // "Antialiasing Complex Global Illumination Effects in Path-space", TOG
 // 2017), kept in the primal domain: P is the 4x4 covariance of the ray
 // bundle's offsets (x, y, θ, φ) in a frame (e1, e2) across the ray. Linear
-// operators A act as P' = A P Aᵀ, and a BSDF lobe of angular standard
-// deviation σ adds σ² to the angular variances (the spectral form of
-// src/covariance.rs: Σ⁻¹ = 4π² P). First order throughout; the surface's
+// operators A act as P' = A P Aᵀ (the spectral form of src/covariance.rs:
+// Σ⁻¹ = 4π² P). Lobes are sampled by the path, so their bandwidth is never
+// added to the footprint (that would filter twice). First order throughout; the surface's
 // exact curvature (shape operator from the analytic Hessian of F') shears
 // the outgoing angles by the tilt of the normal across the footprint.
 //
@@ -96,7 +96,7 @@ mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, vec3 t1, vec3 t2, out 
 // (e1 from t1, e2 from t2, on both sides) a flat mirror is the identity (the
 // unfolded path); the spatial offsets are the surface offsets seen across
 // the outgoing ray; a refraction scales the angles by (η cos θi / cos θt, η)
-// (first order); the lobe's angular standard deviation σ widens the angles.
+// (first order).
 //
 // Curvature (Belcour et al. 2013, sec. 4, "curvature", here in primal form):
 // at surface offset u = (x / |cos θ|, y) the normal facing the incoming ray
@@ -105,9 +105,9 @@ mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, vec3 t1, vec3 t2, out 
 // reflection and refraction laws (in the plane of incidence, then across it):
 // mirror reflection (2, 2 cos θi); refraction (η cos θi / cos θt − 1,
 // η cos θi − cos θt); a diffuse lobe turns with the normal (1, 1). The
-// operator is the shear θ' = s ⊙ θ + g ⊙ (S u).
-void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, vec2 angleScale, mat2 shape, vec2 gain,
-               float lobeSigma) {
+// operator is the shear θ' = s ⊙ θ + g ⊙ (S u). The lobe itself is sampled
+// (the path's direction wi), so its bandwidth is not added here.
+void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, vec2 angleScale, mat2 shape, vec2 gain) {
     vec3 e1n = t1 - wi * dot(wi, t1);
     float el = length(e1n);
     e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, wi));
@@ -123,25 +123,19 @@ void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, vec
     a[0][2] = shear[0][0]; a[0][3] = shear[0][1]; a[1][2] = shear[1][0]; a[1][3] = shear[1][1];
     a[2][2] = angleScale.x;
     a[3][3] = angleScale.y;
-    mat4 p = a * c.p * transpose(a);
-    p[2][2] += lobeSigma * lobeSigma;
-    p[3][3] += lobeSigma * lobeSigma;
-    c.p = covClamp(p);
+    c.p = covClamp(a * c.p * transpose(a));
     c.e1 = e1n;
     c.e2 = e2n;
 }
 
 // A scattering event in a medium, into direction wi: the bundle's spatial
-// offsets are kept, projected across wi (first order), and the phase lobe's
-// angular standard deviation σ widens the angles.
-void covScatter(inout PathCovariance c, vec3 wi, float sigma) {
+// offsets are kept, projected across wi (first order); the phase lobe is
+// sampled, so its spread is not added.
+void covScatter(inout PathCovariance c, vec3 wi) {
     vec3 e1n = c.e1 - wi * dot(wi, c.e1);
     float l = length(e1n);
     e1n = l > 1e-6 ? e1n / l : frameAround(wi)[0];
     covRotate(c, e1n, cross(wi, e1n));
-    c.p[2][2] += sigma * sigma;
-    c.p[3][3] += sigma * sigma;
-    c.p = covClamp(c.p);
 }
 
 #endif

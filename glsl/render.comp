@@ -586,7 +586,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 // phase lobe is sampled, so its spread is not added).
                 if (FILTER_MODE == FILTER_COVARIANCE) {
                     covTravel(cov, ts);
-                    covScatter(cov, wi, 0.0);
+                    covScatter(cov, wi);
                 } else if (FILTER_MODE == FILTER_RAY_CONES) {
                     coneWidth += coneSpread * ts;
                 }
@@ -760,8 +760,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             }
             mat2 shape = shapeOperator(h, ct1, ct2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
             if (FILTER_MODE == FILTER_COVARIANCE) {
-                // The lobe is sampled (bs.wi): its bandwidth is not added.
-                covBounce(cov, covInv, ct1, ct2, normalize(frameW * bs.wi), scale, shape, gain, 0.0);
+                covBounce(cov, covInv, ct1, ct2, normalize(frameW * bs.wi), scale, shape, gain);
             } else {
                 // Ray cones: the curvature term of Akenine-Möller et al. 2021
                 // (the cone's edge rays turn by the gain times the mean

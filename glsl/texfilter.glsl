@@ -111,21 +111,19 @@ vec4 probeLookup(uint index, Footprint fp) {
     float spacing = 4.0 * sigmaRest / float(n - 1);
     // Gaussian weights on the offsets, then the offsets scaled so that the
     // weighted variance is exactly `rest` (with two probes: ±σ, weights ½).
+    float weights[MAX_PROBES];
     float sw = 0.0, sv = 0.0;
     for (int k = 0; k < n; ++k) {
         float o = (float(k) - 0.5 * float(n - 1)) * spacing;
-        float w = exp(-0.5 * o * o / rest);
-        sw += w;
-        sv += w * o * o;
+        weights[k] = exp(-0.5 * o * o / rest);
+        sw += weights[k];
+        sv += weights[k] * o * o;
     }
     float stretch = sqrt(rest * sw / max(sv, 1e-30));
     vec2 step = el.e1 / s0 * (spacing * stretch);
     vec4 sum = vec4(0.0);
     for (int k = 0; k < n; ++k) {
-        float t = float(k) - 0.5 * float(n - 1);
-        float o = t * spacing;
-        float w = exp(-0.5 * o * o / rest);
-        sum += w * textureLod(textures[nonuniformEXT(index)], fp.uv + t * step, lod);
+        sum += weights[k] * textureLod(textures[nonuniformEXT(index)], fp.uv + (float(k) - 0.5 * float(n - 1)) * step, lod);
     }
     return sum / sw;
 }
