@@ -15,13 +15,14 @@
 //! within `BIAS_BOUND`; no pixel further than `OUTLIER_SIGMAS` times the RMS
 //! relative error from its expected value (a local bias shows as outliers);
 //! the RMS (Monte Carlo noise at 256 spp, plus the jittered pixel footprint
-//! against a pixel-centre reference) below `RMS_BOUND`. Pixels that see a
-//! sphere light directly are skipped.
+//! against a pixel-centre reference) below `RMS_BOUND`. Pixels where a
+//! jittered camera ray can see a sphere light directly are skipped.
 
 mod common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::passes::render::PIXEL_FILTER_REACH;
 use quadray::scene::{Light, Material, Scene};
 
 const ALBEDO: f64 = 0.7;
@@ -103,10 +104,15 @@ fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) {
             let ny = 1.0 - 2.0 * (y as f64 + 0.5) / h as f64;
             let dir = DVec3::new(nx * half * w as f64 / h as f64, -1.0, -ny * half).normalize();
             if let Some((c, r)) = visible_sphere {
-                // The ray passes within a pixel's width of the light: skip.
+                // Some camera ray of the pixel can see the light: the
+                // jittered rays land up to PIXEL_FILTER_REACH pixels from
+                // the pixel's centre, a pixel spans 2·tan(fov/2)/h radians
+                // at the image centre (less at its edges), and the light
+                // subtends asin(r/|oc|) around its centre: skip.
                 let oc = c - scene.camera.position;
-                let miss = (oc - oc.dot(dir) * dir).length();
-                if miss < r + 2.0 * half * 8.0 / h as f64 {
+                let angle = oc.normalize().dot(dir).clamp(-1.0, 1.0).acos();
+                let reach = PIXEL_FILTER_REACH as f64 * 2.0 * half / h as f64;
+                if angle < (r / oc.length()).asin() + reach {
                     continue;
                 }
             }

@@ -28,9 +28,19 @@ use quadray::texture::{from_texels, MAX_TEXTURE_SIZE};
 
 const SIZE: (u32, u32) = (96, 64);
 
-/// A floor (y = 0, |x|, |z| ≤ 5) with u = 0.08 x + 0.5 (0.1 to 0.9 across
-/// it), v = 0.08 z + 0.5, seen from a low camera so that the footprints run
-/// from about a texel to grazing.
+/// Texture coordinates per world unit on the floor (see `floor_scene`).
+const TEXTURE_SCALE: f64 = 0.04;
+
+/// A floor (y = 0, |x|, |z| ≤ 5) with u = 0.04 x + 0.5 (0.3 to 0.7 across
+/// it), v = 0.04 z + 0.5, seen from a low camera so that the footprints run
+/// from tens of texels to grazing. Maps repeat, and the ramps below do not:
+/// a lookup that reaches across a map's edge averages in the far end of
+/// the ramp. The floor keeps 0.3 of the map (4915 texels of a 16k map)
+/// from every edge, six times the farthest reach of a lookup here (probes
+/// at ±2σ of the major axis plus the trilinear tent of the probes' level:
+/// about ±0.05 of the map at the grazing end at twice this scale, where
+/// the 16k ramp's error grew to 0.024 at the floor's sides; 1.8e-7 at this
+/// scale).
 fn floor_scene(texture: quadray::scene::TextureImage) -> Scene {
     let floor = FunctionalObject {
         base: Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
@@ -40,7 +50,7 @@ fn floor_scene(texture: quadray::scene::TextureImage) -> Scene {
     let mut object = common::object("floor", floor, DAffine3::IDENTITY);
     object.uv = UvSettings {
         mapping: UvMapping::Planar { u_axis: DVec3::X, v_axis: DVec3::Z },
-        scale: DVec2::splat(0.08),
+        scale: DVec2::splat(TEXTURE_SCALE),
         offset: DVec2::splat(0.5),
     };
     let mut scene = common::scene_with(vec![object]);
@@ -113,11 +123,11 @@ fn a_16k_wide_ramp_is_read_exactly_at_every_footprint() {
     let texels: Vec<[f32; 4]> = (0..4).flat_map(|_| (0..width).map(|i| [ramp(i), 1.0 - ramp(i), 0.5, 1.0])).collect();
     let scene = floor_scene(from_texels("16k ramp".into(), width, 4, texels));
     assert_eq!(scene.textures[0].width, width, "no resampling of a power-of-two width");
-    // Bilinear between texel centres (i + 0.5) / width, clamped away from
-    // the wrap at u = 0 and 1 (not reached: u is in [0.1, 0.9]).
+    // Bilinear between texel centres (i + 0.5) / width (u is in [0.3, 0.7]:
+    // no lookup reaches the wrap at u = 0 and 1).
     let expected = |uv: DVec2| {
         let x = (uv.x * width as f64 - 0.5) / (width - 1) as f64;
-        (0.05..=0.95).contains(&uv.x).then_some([x as f32, (1.0 - x) as f32, 0.5])
+        Some([x as f32, (1.0 - x) as f32, 0.5])
     };
     // One texel of the ramp is 6.1e-5. Bounds: bilinear lookups within 0.16
     // texel (f32 texture coordinates near u = 1 are good to about 2e-3
@@ -184,16 +194,12 @@ fn a_16k_square_map_is_stored_in_8_bits_and_read_at_full_resolution() {
     // Filtered lookups: footprints symmetric about their centre average the
     // ramps to their value there, within the sRGB8 rounding of the stored
     // ramps and its decoding (half a step each: 4.5e-3 together) and the
-    // 16-texel centring bound of the ramp test above (1e-3). The map
-    // repeats, so a footprint reaching across its edge averages in the far
-    // side of the ramp: the floor's far edge (v = 0.10 to 0.11, the last row
-    // of pixels, whose footprints span a tenth of the map along v and read
-    // mips of a few texels, blended across the edge at v = 0) reads up to
-    // 0.05 too high. Pixels with v < 0.15 are left out.
+    // 16-texel centring bound of the ramp test above (1e-3). Every pixel
+    // counts (no lookup reaches the map's edges: see floor_scene).
     let centre = |uv: DVec2| {
         let x = (uv.x * size as f64 - 0.5) / (size - 1) as f64;
         let y = (uv.y * size as f64 - 0.5) / (size - 1) as f64;
-        ((0.05..=0.95).contains(&uv.x) && (0.15..=0.95).contains(&uv.y)).then_some([x as f32, y as f32, 0.5])
+        Some([x as f32, y as f32, 0.5])
     };
     const BOUND: f64 = 4.5e-3 + 1e-3;
     for filter in [FilterMode::RayCones, FilterMode::Covariance] {

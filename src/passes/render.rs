@@ -151,6 +151,13 @@ pub fn render(
 /// split it between jitter and footprint.
 pub const PIXEL_FILTER_SIGMA: f32 = 0.5;
 
+/// How far from its pixel's centre a camera ray can land, in pixels: the
+/// jitter is a Box-Muller Gaussian of σ = [`PIXEL_FILTER_SIGMA`] driven by
+/// 24-bit uniform numbers, so its radius is at most σ·√(−2 ln 2⁻²⁴)
+/// = 2.884 px (`gaussianPixelOffset` in glsl/frame.glsl). Tests that skip
+/// pixels near an edge skip this far.
+pub const PIXEL_FILTER_REACH: f32 = PIXEL_FILTER_SIGMA * 5.768_108;
+
 /// The largest share of the pixel filter's variance that a filtered mode's
 /// footprint carries (at one sample per pixel); the rest is jitter, which
 /// antialiases what texture filtering cannot (object edges, shading).
@@ -592,4 +599,16 @@ fn caustic_map(
         );
     }
     Ok(Some(CausticMap::new(device, gpu, scene, frame, size, &grids)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_filter_reach_is_the_largest_box_muller_radius() {
+        // The smallest 1 - u of a 24-bit uniform number is 2⁻²⁴.
+        let reach = PIXEL_FILTER_SIGMA as f64 * (-2.0 * (2.0f64).powi(-24).ln()).sqrt();
+        assert!((PIXEL_FILTER_REACH as f64 - reach).abs() < 1e-5, "{reach}");
+    }
 }
