@@ -20,6 +20,7 @@
 #include "interface.glsl"
 #include "frame.glsl"
 #include "caustics.glsl"
+#include "balance.glsl"
 
 layout(local_size_x = CAUSTIC_GROUP) in;
 
@@ -41,7 +42,7 @@ void main() {
     uvec2 grid = pc.emitter.grid;
     int stride = int(BEAM_STRIDE);
     uvec2 beams = (grid - 1u) / uint(stride);
-    uint i = gl_GlobalInvocationID.x;
+    uint i = balancedIndex(CAUSTIC_GROUP);
     if (i >= beams.x * beams.y) return;
     ivec2 c = ivec2(i % beams.x, i / beams.x) * stride;
     ivec2 corner[4] = ivec2[4](c, c + ivec2(stride, 0), c + ivec2(stride, stride), c + ivec2(0, stride));

@@ -17,6 +17,7 @@
 #include "interface.glsl"
 #include "frame.glsl"
 #include "caustics.glsl"
+#include "balance.glsl"
 
 layout(set = 0, binding = BINDING_CAUSTIC_RAYS, scalar) buffer CausticRays { CausticRay causticRays[]; };
 layout(set = 0, binding = BINDING_GBUFFER, scalar) buffer Receivers { Receiver receivers[]; };
@@ -85,7 +86,7 @@ void addIrradiance(uint pixel, vec3 e) {
 
 void main() {
     uvec2 grid = pc.emitter.grid;
-    uint i = gl_GlobalInvocationID.x;
+    uint i = balancedIndex(CAUSTIC_GROUP);
     if (grid.x < 2u || grid.y < 2u || i >= (grid.x - 1u) * (grid.y - 1u)) return;
     ivec2 c = ivec2(i % (grid.x - 1u), i / (grid.x - 1u));
     if (!cellValid(c)) return;

@@ -22,6 +22,7 @@ layout(local_size_x = CAUSTIC_GROUP) in;
 layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials { Material materials[]; };
 
 #include "stack.glsl"
+#include "balance.glsl"
 
 layout(push_constant, scalar) uniform Push { Emitter emitter; } pc;
 
@@ -33,7 +34,7 @@ uint extendPath(uint path, uint value) { return (path ^ value) * 16777619u; }
 
 void main() {
     Emitter e = pc.emitter;
-    uint i = gl_GlobalInvocationID.x;
+    uint i = balancedIndex(CAUSTIC_GROUP);
     if (i >= e.grid.x * e.grid.y) return;
     uvec2 g = uvec2(i % e.grid.x, i / e.grid.x);
     vec2 xy = mix(e.lo, e.hi, (vec2(g) + 0.5) / vec2(e.grid));

@@ -5,13 +5,14 @@
 #include "intersect.glsl"
 #include "frame.glsl"
 #include "caustics.glsl"
+#include "balance.glsl"
 
 layout(set = 0, binding = BINDING_GBUFFER, scalar) buffer Receivers { Receiver receivers[]; };
 
 layout(local_size_x = RENDER_GROUP, local_size_y = RENDER_GROUP) in;
 
 void main() {
-    uvec2 pix = gl_GlobalInvocationID.xy;
+    uvec2 pix = balancedPixel(RENDER_GROUP);
     if (pix.x >= frame.width || pix.y >= frame.height) return;
     SceneHit h = traceScene(frame.eye, cameraRay(vec2(pix) + 0.5), 0.0, 1e30);
     Receiver r;

@@ -9,6 +9,7 @@
 #include "random.glsl"
 #include "lights.glsl"
 #include "uv.glsl"
+#include "balance.glsl"
 
 layout(local_size_x = RENDER_GROUP, local_size_y = RENDER_GROUP) in;
 
@@ -793,7 +794,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
 }
 
 void main() {
-    uvec2 local = gl_GlobalInvocationID.xy;
+    uvec2 local = balancedPixel(RENDER_GROUP);
     if (any(greaterThanEqual(local, pc.tileSize))) return;
     uvec2 pix = pc.tileOrigin + local;
     uint idx = pix.y * frame.width + pix.x;

@@ -25,6 +25,7 @@ layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light
 
 #include "frame.glsl"
 #include "light_queries.glsl"
+#include "balance.glsl"
 
 // Mean in-scattered radiance per pixel (RGB), accumulated over dispatches.
 layout(set = 0, binding = BINDING_VOLUME, scalar) buffer Volume { float volume[]; };
@@ -109,7 +110,7 @@ vec3 inScattered(Medium fog, vec3 o, vec3 d, float tEnd, uint i, inout uint rng)
 }
 
 void main() {
-    uvec2 pix = gl_GlobalInvocationID.xy;
+    uvec2 pix = balancedPixel(RENDER_GROUP);
     if (pix.x >= frame.width || pix.y >= frame.height) return;
     Medium fog = fogMedium();
     uint rng = seedRandom(pix, 0x5eed0000u + pc.firstSample, frame.seed);
