@@ -188,9 +188,20 @@ double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double 
     float step = 1e-3 * float(tb - ta);
     bool found = tr != NO_ROOT;
     if (found) {
-        // A root where F' stays far from its terms' size a little way off
-        // is well conditioned in f32 and kept as it is.
-        if (!startUncertain && !nearlyCancels(c, tr + step, 1e-2) && !nearlyCancels(c, tr - step, 1e-2)) return t;
+        // Kept as f32 found it where it is well conditioned: Horner's
+        // evaluation of c near tr errs by at most about 16 ε of the size of
+        // its terms there (S = Σ|c_j| |tr|^j, ε = 2⁻²⁴ for degree 6), which
+        // moves the root by 16 ε S / |c'(tr)|. Within 1e-5 of the piece it
+        // is kept (ten times below the secondary rays' offset of 1e-4 of
+        // the cell's width); a flatter root is settled in f64.
+        float slope;
+        evalPoly(c, tr, slope);
+        float size = 0.0, xp = 1.0;
+        for (int j = 0; j < 7; ++j) {
+            size += abs(c[j]) * xp;
+            xp *= abs(tr);
+        }
+        if (!startUncertain && 16.0 * 5.96e-8 * size <= 1e-5 * float(tb - ta) * abs(slope)) return t;
     } else if (!startUncertain && !signUncertain(c, float(tb - tm))) {
         return -1.0;
     }
