@@ -2,7 +2,6 @@
 // Traces a list of world-space rays and writes the closest hit of each:
 // the GPU side of the GPU-vs-CPU geometry tests and of the ray benchmark.
 #include "intersect.glsl"
-#include "balance.glsl"
 
 layout(local_size_x = PROBE_GROUP) in;
 
@@ -35,9 +34,8 @@ layout(push_constant, scalar) uniform Push {
 } pc;
 
 void main() {
-    uint local = balancedIndex(PROBE_GROUP);
-    if (local >= pc.count) return;
-    uint i = pc.first + local;
+    uint i = pc.first + gl_GlobalInvocationID.x;
+    if (gl_GlobalInvocationID.x >= pc.count) return;
     Ray r = rays[i];
     vec3 o = vec3(r.origin[0], r.origin[1], r.origin[2]);
     vec3 d = vec3(r.dir[0], r.dir[1], r.dir[2]);
