@@ -7,7 +7,9 @@
 //! count, `-- --max-per-cell K` to change how finely objects are split into
 //! cells). GPU time comes from timestamps around the probe dispatches; the
 //! first run of each configuration is discarded (lavapipe compiles the
-//! shader at its first dispatch), the median of the next runs is kept.
+//! shader at its first dispatch); then every configuration runs once per
+//! round, for `RUNS` rounds, and the median is kept, so that the machine's
+//! drift over the run affects every configuration alike.
 
 use std::sync::Arc;
 
@@ -22,7 +24,7 @@ use quadray::vk::{Commands, Context};
 const COUNTS: [usize; 4] = [0, 10, 100, 1000];
 const BUMP_RADIUS: f64 = 0.05;
 const FORM_FACTOR: f64 = 0.05;
-const RUNS: usize = 7;
+const RUNS: usize = 9;
 
 fn sphere_scene(n: usize) -> Scene {
     let shape = FunctionalObject {
@@ -88,7 +90,7 @@ fn main() {
     let mut cmds = Commands::new(&device).unwrap();
     let rays = grid_rays(side);
     println!(
-        "device: {}; {} rays per run, median of {} runs after a discarded first run; cells split to <= {} perturbations\n",
+        "device: {}; {} rays per run, median of {} rounds (every configuration once a round) after a discarded first run; cells split to <= {} perturbations\n",
         device.name,
         rays.len(),
         RUNS,
@@ -107,27 +109,41 @@ fn main() {
         "table B/pert",
         "accel bytes"
     );
-    let mut base_ms = None;
-    let mut base_table = 0u64;
-    for n in COUNTS {
-        let scene = sphere_scene(n);
-        let gpu = GpuScene::new(&device, &mut cmds, &scene, &params).unwrap();
-        let timed = |mode: u32, cmds: &mut Commands| {
-            let probe = ProbePass::new(&device, &gpu, &rays, mode, false).unwrap();
-            let (hits, _) = probe.run(cmds).unwrap(); // discarded: the shader compiles here
-            let mut times: Vec<f64> = (0..RUNS).map(|_| probe.run(cmds).unwrap().1 * 1e-6).collect();
-            times.sort_by(f64::total_cmp);
-            (hits, times[RUNS / 2])
-        };
-        let (hits, ms) = timed(INTERSECT_FULL, &mut cmds);
-        let (_, boxes_ms) = timed(INTERSECT_BOXES, &mut cmds);
-        let (_, base_only_ms) = timed(INTERSECT_BASE, &mut cmds);
-        let hit_fraction = hits.iter().filter(|h| h.object != NO_HIT).count() as f64 / hits.len() as f64;
-        let base = *base_ms.get_or_insert(ms);
-        let stats = gpu.stats;
-        if n == 0 {
-            base_table = stats.table_bytes;
+    // Every configuration (count and mode) is built and warmed up first,
+    // then timed once per round, round after round: the machine's speed
+    // drifts by 10 - 30 % over minutes, and interleaving makes every
+    // configuration see the same drift, so that the ratios hold.
+    let modes = [INTERSECT_FULL, INTERSECT_BOXES, INTERSECT_BASE];
+    let gpus: Vec<GpuScene> =
+        COUNTS.iter().map(|&n| GpuScene::new(&device, &mut cmds, &sphere_scene(n), &params).unwrap()).collect();
+    let probes: Vec<Vec<ProbePass>> = gpus
+        .iter()
+        .map(|gpu| modes.iter().map(|&mode| ProbePass::new(&device, gpu, &rays, mode, false).unwrap()).collect())
+        .collect();
+    // Discarded: each shader variant compiles at its first dispatch.
+    let hits: Vec<_> = probes.iter().map(|p| p[0].run(&mut cmds).unwrap().0).collect();
+    for p in probes.iter().flatten().skip(1) {
+        p.run(&mut cmds).unwrap();
+    }
+    let mut times = vec![vec![Vec::new(); modes.len()]; COUNTS.len()];
+    for _ in 0..RUNS {
+        for (i, per_mode) in probes.iter().enumerate() {
+            for (m, probe) in per_mode.iter().enumerate() {
+                times[i][m].push(probe.run(&mut cmds).unwrap().1 * 1e-6);
+            }
         }
+    }
+    let median = |v: &[f64]| {
+        let mut v = v.to_vec();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let base_ms = median(&times[0][0]);
+    let base_table = gpus[0].stats.table_bytes;
+    for (i, &n) in COUNTS.iter().enumerate() {
+        let [ms, boxes_ms, base_only_ms] = [0, 1, 2].map(|m| median(&times[i][m]));
+        let hit_fraction = hits[i].iter().filter(|h| h.object != NO_HIT).count() as f64 / hits[i].len() as f64;
+        let stats = gpus[i].stats;
         let per_pert =
             if n > 0 { format!("{:.1}", (stats.table_bytes - base_table) as f64 / n as f64) } else { "-".into() };
         println!(
@@ -137,7 +153,7 @@ fn main() {
             100.0 * hit_fraction,
             ms,
             rays.len() as f64 / (ms * 1e3),
-            ms / base,
+            ms / base_ms,
             boxes_ms,
             base_only_ms,
             per_pert,

@@ -70,6 +70,20 @@ float quadraticFirstRoot(vec3 q, float lo, float hi) {
     return NO_ROOT;
 }
 
+// The range (min, max) of x + y s + z s² over [lo, hi].
+vec2 quadraticRange(vec3 q, float lo, float hi) {
+    float a = q.x + lo * (q.y + lo * q.z), b = q.x + hi * (q.y + hi * q.z);
+    vec2 r = vec2(min(a, b), max(a, b));
+    if (q.z != 0.0) {
+        float v = -q.y / (2.0 * q.z);
+        if (v > lo && v < hi) {
+            float m = q.x + v * (q.y + v * q.z);
+            r = vec2(min(r.x, m), max(r.y, m));
+        }
+    }
+    return r;
+}
+
 // True when x + y s + z s² > 0 somewhere in [lo, hi].
 bool positiveSomewhere(vec3 q, float lo, float hi) {
     if (q.x + lo * (q.y + lo * q.z) > 0.0 || q.x + hi * (q.y + hi * q.z) > 0.0) return true;
@@ -79,10 +93,12 @@ bool positiveSomewhere(vec3 q, float lo, float hi) {
 }
 
 // True when perturbation k is non-zero somewhere on p + s d, s in [lo, hi]:
-// first a cheap test against its bounding sphere, then its quadric.
-bool perturbationOnSegment(uint k, vec3 p, vec3 d, float lo, float hi) {
+// first a cheap test against its bounding sphere, then its quadric, whose
+// restriction to the ray it returns in `q`.
+bool perturbationOnSegment(uint k, vec3 p, vec3 d, float lo, float hi, out vec3 q) {
     vec3 h = p - v3(perturbations[k].centre);
     float radius = perturbations[k].radius;
+    q = vec3(0.0);
     if (radius >= 0.0) {
         float dd = dot(d, d), b = dot(h, d);
         float disc = b * b - dd * (dot(h, h) - radius * radius);
@@ -90,7 +106,8 @@ bool perturbationOnSegment(uint k, vec3 p, vec3 d, float lo, float hi) {
         float sq = sqrt(disc);
         if ((-b + sq) < lo * dd || (-b - sq) > hi * dd) return false;
     }
-    return positiveSomewhere(quadricAlongRay(perturbations[k].q, h, d), lo, hi);
+    q = quadricAlongRay(perturbations[k].q, h, d);
+    return positiveSomewhere(q, lo, hi);
 }
 
 // Perturbations of one cell that are positive somewhere on the ray segment;
@@ -284,10 +301,19 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
             overflow = false;
             for (uint i = 0; i < cell.count; ++i) {
                 uint k = cellLists[cell.first + i];
-                if (perturbationOnSegment(k, p, d, segLo, segHi)) {
+                vec3 q;
+                if (perturbationOnSegment(k, p, d, segLo, segHi, q)) {
                     if (nrel == MAX_RELEVANT) { overflow = true; break; }
-                    relQ[nrel] = perturbationAlongRay(k, p, d);
-                    relF[nrel] = perturbations[k].f;
+                    // Stored by constant indices (a select per slot): a
+                    // store at the lane's own index nrel would keep the
+                    // arrays in scratch memory on lavapipe (a scatter).
+                    float f = perturbations[k].f;
+                    [[unroll]] for (uint j = 0u; j < MAX_RELEVANT; ++j) {
+                        if (j == nrel) {
+                            relQ[j] = q;
+                            relF[j] = f;
+                        }
+                    }
                     ++nrel;
                 }
             }
@@ -319,13 +345,29 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
             vec3 b = shiftQuadratic(base, sm);
             float c[7] = float[7](b.x, b.y, b.z, 0.0, 0.0, 0.0, 0.0);
             bool any = false;
+            // Interval bounds of F' on the piece: the base quadratic's range
+            // plus each active term's, f · [min q, max q]³ (q > 0 on the
+            // whole piece). A range that excludes 0 by more than f32's
+            // rounding of the terms (1e-5 of their size, as signUncertain)
+            // holds no root: the piece is passed without root isolation.
+            vec2 range = quadraticRange(b, sa - sm, sb - sm);
+            float size = max(abs(range.x), abs(range.y));
             for (uint i = 0; i < nrel; ++i) {
                 uint k = all ? cellLists[cell.first + i] : 0u;
                 vec3 q = shiftQuadratic(all ? perturbationAlongRay(k, p, d) : relQ[i], sm);
                 if (q.x > 0.0) {
-                    addCube(c, q, all ? perturbations[k].f : relF[i]);
+                    float f = all ? perturbations[k].f : relF[i];
+                    addCube(c, q, f);
                     any = true;
+                    vec2 qr = max(quadraticRange(q, sa - sm, sb - sm), vec2(0.0));
+                    vec2 cubes = f * qr * qr * qr;
+                    range += vec2(min(cubes.x, cubes.y), max(cubes.x, cubes.y));
+                    size += abs(f) * qr.y * qr.y * qr.y;
                 }
+            }
+            if (any && (range.x > 1e-5 * size || range.y < -1e-5 * size)) {
+                sa = sb;
+                continue;
             }
             float r = any ? firstRoot(c, sa - sm, sb - sm) : quadraticFirstRoot(b, sa - sm, sb - sm);
             if (any) {
