@@ -23,6 +23,7 @@ pub mod scene;
 pub mod shader_interface;
 pub mod shaders;
 pub mod texture;
+pub mod throughput;
 pub mod viewer;
 pub mod vk;
 
