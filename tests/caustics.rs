@@ -84,14 +84,22 @@ fn lens_over_plane_matches_the_brute_force_path_tracer() {
     let c = common::compare_with_brute_force("lens", 4096, 64);
     let report = c.fast.caustics.as_ref().expect("the caustic passes ran");
     println!(
-        "lens: FLIP against brute force at 4096 spp: caustic passes at 64 spp {:.4} (bound {LENS_FLIP_BOUND}), \
-         brute force at 64 spp {:.4}; caustic passes {:.3} s for {} rays",
+        "lens: FLIP against brute force at 4096 spp: caustic passes at 64 spp {:.4} (bound {LENS_FLIP_BOUND}); \
+         caustic passes {:.3} s for {} rays",
         c.flip_fast,
-        c.flip_brute,
         report.seconds(),
         report.rays
     );
     assert!(c.flip_fast < LENS_FLIP_BOUND);
+    // What the passes are for: at equal GPU time (brute force gets
+    // EQUAL_TIME_MARGIN times as much), a smaller error than brute force's.
+    assert!(
+        c.rel_fast < c.rel_brute,
+        "caustic passes relMSE {} not below brute force's {} at {:.2}x their GPU time",
+        c.rel_fast,
+        c.rel_brute,
+        c.brute.seconds / c.fast.seconds
+    );
 }
 
 #[test]
@@ -114,9 +122,11 @@ fn lens_in_fog_beams_match_the_brute_force_path_tracer() {
     let report = c.fast.caustics.as_ref().expect("the caustic passes ran");
     assert!(report.beam_seconds > 0.0, "the beam pass ran");
     println!(
-        "lens in fog: FLIP against brute force at 2048 spp: passes at 64 spp {:.4} (bound {LENS_FOG_FLIP_BOUND}), \
-         brute force at 64 spp {:.4}",
-        c.flip_fast, c.flip_brute
+        "lens in fog: FLIP against brute force at 2048 spp: passes at 64 spp {:.4} (bound {LENS_FOG_FLIP_BOUND})",
+        c.flip_fast
     );
+    // At equal GPU time brute force's error is below the passes' here
+    // (relMSE 0.07 against 0.22 when measured): the beams do not pay yet
+    // (issue 16's note), so this test bounds the passes' error only.
     assert!(c.flip_fast < LENS_FOG_FLIP_BOUND);
 }

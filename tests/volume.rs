@@ -14,10 +14,14 @@ fn fog_with_shadow_matches_the_brute_force_path_tracer() {
     let c = common::compare_with_brute_force("fog_shadow", 2048, 64);
     let seconds = c.fast.volume_seconds.expect("the volume pass ran");
     println!(
-        "fog_shadow: FLIP against brute force at 2048 spp: volume pass at 64 spp {:.4} (bound {FOG_FLIP_BOUND}), \
-         brute force at 64 spp {:.4}; volume pass {seconds:.3} s",
-        c.flip_fast, c.flip_brute
+        "fog_shadow: FLIP against brute force at 2048 spp: volume pass at 64 spp {:.4} (bound {FOG_FLIP_BOUND}); \
+         volume pass {seconds:.3} s",
+        c.flip_fast
     );
+    // At equal GPU time brute force's error is below the pass's here (relMSE
+    // 0.021 against 0.041 when measured: the pass repeats the path tracer's
+    // own equiangular estimate on extra camera rays), so this test bounds
+    // the pass's error only (issue 16's note).
     assert!(c.flip_fast < FOG_FLIP_BOUND);
 }
 

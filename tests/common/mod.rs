@@ -216,22 +216,34 @@ pub fn test_objects() -> Vec<SceneObject> {
 }
 
 /// A scene file's render with the caustic and volume passes against the
-/// brute-force path tracer (both passes off).
+/// brute-force path tracer (both passes off), at equal GPU time.
 pub struct BruteForceComparison {
     /// Brute force at `reference_spp`.
     pub reference: quadray::passes::RenderOutput,
     /// With the passes, at `spp`.
     pub fast: quadray::passes::RenderOutput,
-    /// Brute force at `spp`.
+    /// Brute force with EQUAL_TIME_MARGIN times the GPU time of `fast`.
     pub brute: quadray::passes::RenderOutput,
     /// FLIP of `fast` against `reference`.
     pub flip_fast: f64,
     /// FLIP of `brute` against `reference`.
     pub flip_brute: f64,
+    /// Relative MSE of `fast` against `reference` (linear radiance).
+    pub rel_fast: f64,
+    /// Relative MSE of `brute` against `reference`.
+    pub rel_brute: f64,
 }
 
+/// How much more GPU time than the passes' render the brute-force render
+/// gets. GPU times on lavapipe vary by 10 - 30 % between runs, so brute
+/// force is given half as much time again: a pass that still wins pays
+/// whatever the noise did.
+pub const EQUAL_TIME_MARGIN: f64 = 1.5;
+
 /// Renders `scenes/tests/{name}.toml` three ways (see
-/// [`BruteForceComparison`]); with QUADRAY_TEST_IMAGES set to a folder,
+/// [`BruteForceComparison`]): the brute-force spp is measured from a
+/// render at `spp`, then raised to EQUAL_TIME_MARGIN times the GPU time of
+/// the render with the passes. With QUADRAY_TEST_IMAGES set to a folder,
 /// writes the three images there as `{name}_*.png`.
 pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> BruteForceComparison {
     use quadray::passes::RenderVariant;
@@ -245,15 +257,34 @@ pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> Bru
     // the first `spp` samples of the reference those of `brute`).
     scene.image.spp = spp;
     scene.image.seed = scene.image.seed.wrapping_add(1);
+    // Untimed: lavapipe compiles each shader variant at its first dispatch
+    // (into its disk cache), and that time would count as GPU time.
+    let mut small = scene.clone();
+    (small.image.width, small.image.height, small.image.spp) = (8, 8, 1);
+    render_variant_validated(&small, RenderVariant::default());
     let fast = render_variant_validated(&scene, RenderVariant::default());
-    let brute = render_variant_validated(&scene, brute_force);
+    let probe = render_variant_validated(&scene, brute_force);
+    let per_sample = probe.seconds / spp as f64;
+    scene.image.spp = ((EQUAL_TIME_MARGIN * fast.seconds / per_sample).ceil() as u32).max(spp);
+    let brute = if scene.image.spp == spp { probe } else { render_variant_validated(&scene, brute_force) };
     let flip_fast = quadray::metrics::flip_mean(&reference, &fast, 0.0).unwrap();
     let flip_brute = quadray::metrics::flip_mean(&reference, &brute, 0.0).unwrap();
+    let rel_fast = quadray::metrics::relative_mse(&reference, &fast).unwrap();
+    let rel_brute = quadray::metrics::relative_mse(&reference, &brute).unwrap();
+    println!(
+        "{name}: passes at {spp} spp in {:.2} s GPU; brute force at {} spp in {:.2} s ({:.2}x the time); \
+         against brute force at {reference_spp} spp: relMSE {rel_fast:.5} against {rel_brute:.5}, FLIP \
+         {flip_fast:.4} against {flip_brute:.4}",
+        fast.seconds,
+        brute.spp,
+        brute.seconds,
+        brute.seconds / fast.seconds
+    );
     if let Ok(dir) = std::env::var("QUADRAY_TEST_IMAGES") {
         let dir = std::path::Path::new(&dir);
         for (kind, out) in [("reference", &reference), ("passes", &fast), ("brute", &brute)] {
             quadray::output::write_png(out, 0.0, &dir.join(format!("{name}_{kind}.png"))).unwrap();
         }
     }
-    BruteForceComparison { reference, fast, brute, flip_fast, flip_brute }
+    BruteForceComparison { reference, fast, brute, flip_fast, flip_brute, rel_fast, rel_brute }
 }
