@@ -43,7 +43,7 @@ fn sphere_scene(n: usize) -> Scene {
             filter: Default::default(),
             preset: None,
         },
-        camera: Camera { position: DVec3::new(0.0, 0.0, 4.0), look_at: DVec3::ZERO, up: DVec3::Y, vfov_degrees: 40.0 },
+        camera: Camera::still(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, DVec3::Y, 40.0),
         background: Vec3::ZERO,
         materials: vec![Material::diffuse("grey", Vec3::splat(0.8))],
         objects: vec![SceneObject {

@@ -306,8 +306,7 @@ fn cache_path(cache: &Path, s: &BenchScene, reference: &Scene) -> PathBuf {
         reference.quality(),
         reference.image.seed
     );
-    // FNV-1a, 64 bits.
-    let hash = key.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3));
+    let hash = crate::hash::Fnv1a::of(key.as_bytes());
     cache.join(format!("{}-reference-{hash:016x}.exr", s.name))
 }
 

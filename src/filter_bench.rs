@@ -341,8 +341,7 @@ impl ReferenceInfo {
 
 /// FNV-1a (64 bit) of `bytes`, in hex: a stable cache key.
 pub fn fnv1a_hex(bytes: &[u8]) -> String {
-    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
-    format!("{hash:016x}")
+    format!("{:016x}", crate::hash::Fnv1a::of(bytes))
 }
 
 /// The time at which a curve of (seconds, error) points, in the order of

@@ -13,6 +13,8 @@ pub mod covariance;
 pub mod filter_bench;
 pub mod geometry;
 pub mod hash;
+pub mod job;
+pub mod merge;
 pub mod metrics;
 pub mod output;
 pub mod passes;
@@ -48,6 +50,13 @@ pub enum RenderError {
         /// What is wrong.
         source: geometry::GeometryError,
     },
+    /// Pixel bounds that are empty or outside the frame.
+    #[error(transparent)]
+    Bounds(#[from] passes::bounds::BoundsError),
+    /// An accumulation that does not fit the renderer (another image size,
+    /// crop or sample target).
+    #[error("the accumulation does not fit this render: {0}")]
+    Accumulation(String),
 }
 
 impl From<ash::vk::Result> for RenderError {
@@ -80,7 +89,7 @@ pub fn render_scene_with(
         &mut cmds,
         scene,
         &geometry::CellParams::default(),
-        scene.camera.position,
+        scene.camera.render_origin(),
     )?;
     let im = &scene.image;
     passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), variant, progress)

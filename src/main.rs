@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use quadray::output::{write_exr, write_outputs, ExrPrecision, OutputKind};
+use quadray::output::{write_exr, write_outputs_with, ExrPrecision, OutputKind};
 use quadray::progress::ProgressBar;
 use quadray::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
@@ -44,6 +44,11 @@ enum Command {
     /// Compare a render with a reference: FLIP (mean, from nv-flip) and
     /// relative MSE between two EXR files of the same size.
     Compare(CompareArgs),
+    /// Assemble tiles or crops of one render (EXR files of `render --tile`
+    /// or `--crop`) into the whole frame: PNG and EXR with the AOVs. Refuses
+    /// tiles of different scenes, settings or frames, unfinished tiles, gaps
+    /// and overlaps, and then writes nothing.
+    Merge(MergeArgs),
     /// Measure samples per second and CPU use of whole `quadray render`
     /// processes on the throughput scenes, optionally beside an older binary
     /// (`--baseline`) in the same run; writes throughput.json and
@@ -118,6 +123,20 @@ struct ViewArgs {
     /// Enable the Khronos validation layer; the command fails if it reports errors.
     #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     validation: bool,
+}
+
+#[derive(Parser, Debug)]
+struct MergeArgs {
+    /// The tiles' EXR files.
+    #[arg(required = true)]
+    tiles: Vec<PathBuf>,
+    /// Output path, as `render -o`: `NAME.png`, `NAME.exr`, or a name
+    /// without those extensions for both.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Write the EXR with 16-bit half floats instead of 32-bit floats.
+    #[arg(long)]
+    half: bool,
 }
 
 #[derive(Parser, Debug)]
@@ -345,6 +364,80 @@ struct RenderArgs {
     /// those passes are compared with).
     #[arg(long)]
     brute_force: bool,
+    /// Write checkpoints of the work so far to this file (atomically), every
+    /// --checkpoint-every seconds and when the render is stopped by SIGINT,
+    /// SIGTERM or --time-limit; removed once the render completes and its
+    /// images are written. Default with --resume: the file resumed from.
+    #[arg(long)]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(long, default_value_t = 300.0, value_parser = positive_seconds)]
+    checkpoint_every: f64,
+    /// Continue the render saved in this checkpoint (refused unless the
+    /// scene file and every flag that changes the image are the same).
+    #[arg(long)]
+    resume: Option<PathBuf>,
+    /// Render until this many seconds have passed, then write the image so
+    /// far (and the checkpoint, with --checkpoint) and exit with status 0;
+    /// the images' `quadray.spp` metadata says how many samples they have.
+    #[arg(long, value_parser = positive_seconds)]
+    time_limit: Option<f64>,
+    /// Render only these pixel bounds of the frame: x0,x1,y0,y1 (columns
+    /// x0..x1, rows y0..y1, half-open, row 0 at the top; pbrt-v4's
+    /// --pixelbounds). The EXR's data window is the crop, its display
+    /// window the frame.
+    #[arg(long, conflicts_with = "tile")]
+    crop: Option<quadray::passes::PixelBounds>,
+    /// Render tile i of N: the frame split into N bands of whole rows, band
+    /// i covering rows floor(i·H/N) to floor((i+1)·H/N). `quadray merge`
+    /// assembles the tiles.
+    #[arg(long)]
+    tile: Option<quadray::passes::TileIndex>,
+    /// Render frame F of the scene's camera animation (`[[camera.keyframes]]`,
+    /// frame F at time F / camera.fps); outputs are numbered: NAME.0002.png.
+    #[arg(long = "frame", conflicts_with = "frames")]
+    animation_frame: Option<u32>,
+    /// Render frames A to B (inclusive), every STEP-th (default 1), in one
+    /// process that builds its shaders once: A-B or A-B:STEP. Outputs are
+    /// numbered: NAME.0001.exr, NAME.0002.exr, ...
+    #[arg(long)]
+    frames: Option<FrameRange>,
+}
+
+/// `--frames A-B[:STEP]`.
+#[derive(Clone, Copy, Debug)]
+struct FrameRange {
+    first: u32,
+    last: u32,
+    step: u32,
+}
+
+impl std::str::FromStr for FrameRange {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let err = || format!("{s:?}: a frame range is A-B or A-B:STEP (e.g. 1-48 or 1-48:2), A <= B, STEP >= 1");
+        let (range, step) = s.split_once(':').map_or((s, "1"), |(r, st)| (r, st));
+        let (a, b) = range.split_once('-').ok_or_else(err)?;
+        let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| err());
+        let (first, last, step) = (parse(a)?, parse(b)?, parse(step)?);
+        if first > last || step == 0 {
+            return Err(err());
+        }
+        Ok(Self { first, last, step })
+    }
+}
+
+/// Exit status of a render stopped by SIGINT or SIGTERM after it wrote its
+/// image so far (and its checkpoint): EX_TEMPFAIL of sysexits.h, "try
+/// again later".
+const EXIT_INTERRUPTED: i32 = 75;
+
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("{s:?} is not a positive number of seconds")),
+    }
 }
 
 /// Which files `-o` asks for.
@@ -438,6 +531,27 @@ fn load(args: &RenderArgs) -> Result<Scene> {
     Ok(scene)
 }
 
+/// Which frames `--frame` and `--frames` ask for (none: the still camera,
+/// outputs without a frame number).
+fn requested_frames(args: &RenderArgs) -> Option<Vec<u32>> {
+    match (args.animation_frame, args.frames) {
+        (Some(f), _) => Some(vec![f]),
+        (None, Some(r)) => Some((r.first..=r.last).step_by(r.step as usize).collect()),
+        (None, None) => None,
+    }
+}
+
+/// `path` with the frame number before its extension: `out.exr` →
+/// `out.0002.exr`.
+fn frame_path(path: &Path, frame: u32) -> PathBuf {
+    let stem = path.file_stem().map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    let name = match path.extension() {
+        Some(e) => format!("{stem}.{frame:04}.{}", e.to_string_lossy()),
+        None => format!("{stem}.{frame:04}"),
+    };
+    path.with_file_name(name)
+}
+
 fn render(args: RenderArgs) -> Result<()> {
     let scene = load(&args)?;
     if args.output.is_dir() || args.output.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
@@ -455,25 +569,122 @@ fn render(args: RenderArgs) -> Result<()> {
             }
         }
     }
+    let frames = requested_frames(&args);
+    if frames.as_ref().is_some_and(|f| f.len() > 1) && (args.checkpoint.is_some() || args.resume.is_some()) {
+        bail!("--checkpoint and --resume take one frame at a time (--frame F), not a --frames range");
+    }
+    let bounds = match (args.crop, args.tile) {
+        (Some(crop), _) => crop.check(scene.image.width, scene.image.height)?,
+        (None, Some(t)) => quadray::passes::PixelBounds::tile(t.index, t.count, scene.image.width, scene.image.height)?,
+        (None, None) => quadray::passes::PixelBounds::full(scene.image.width, scene.image.height),
+    };
+    if args.bench
+        && (args.checkpoint.is_some()
+            || args.resume.is_some()
+            || args.time_limit.is_some()
+            || frames.is_some()
+            || !bounds.is_full(scene.image.width, scene.image.height))
+    {
+        bail!(
+            "--bench renders the whole frame at once: it takes no --checkpoint, --resume, --time-limit, --crop, \
+             --tile, --frame or --frames"
+        );
+    }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
     let filter = scene.image.filter.constant();
-    let out = if args.bench {
-        bench(&ctx, &scene, filter)?
-    } else {
-        let mut progress = ProgressBar::new(args.progress);
-        let variant = quadray::passes::RenderVariant {
-            filter,
-            caustics: !args.brute_force,
-            volume: !args.brute_force,
-            ..Default::default()
-        };
-        let out = quadray::render_scene_with(&ctx, &scene, variant, &mut |d, t| progress.update(d, t));
-        progress.finish();
-        out.context("render failed")?
+    let variant = quadray::passes::RenderVariant {
+        filter,
+        caustics: !args.brute_force,
+        volume: !args.brute_force,
+        ..Default::default()
     };
+    let mut interrupted = false;
+    if args.bench {
+        let out = bench(&ctx, &scene, filter)?;
+        write_render(&args, &ctx, &scene, variant, &outputs, None, &out, quadray::job::JobEnd::Complete)?;
+    } else {
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            // A second signal ends the process at once (exit status 1).
+            signal_hook::flag::register_conditional_shutdown(signal, 1, stop.clone())?;
+            signal_hook::flag::register(signal, stop.clone())?;
+        }
+        let options = quadray::job::JobOptions {
+            bounds,
+            checkpoint: args.checkpoint.clone().or_else(|| args.resume.clone()),
+            checkpoint_every: std::time::Duration::from_secs_f64(args.checkpoint_every),
+            resume: args.resume.clone(),
+            time_limit: args.time_limit.map(std::time::Duration::from_secs_f64),
+            stop,
+            scene_name: args.scene.as_ref().map_or(DEFAULT_SCENE_NAME.to_string(), |p| p.display().to_string()),
+        };
+        // One job for every frame: the scene is uploaded and the shaders
+        // built once.
+        let list: Vec<Option<u32>> = frames.map_or(vec![None], |f| f.into_iter().map(Some).collect());
+        let first = list[0].map_or_else(|| scene.clone(), |f| scene.at_frame(f));
+        if let Some(path) = &options.resume {
+            // A wrong checkpoint is refused before any GPU work.
+            let key = quadray::job::job_key(&first, variant, bounds);
+            quadray::passes::Checkpoint::read(path).map_err(anyhow::Error::from).and_then(|c| {
+                if c.key == key {
+                    Ok(())
+                } else {
+                    Err(quadray::passes::checkpoint::CheckpointError::OtherRender {
+                        path: path.clone(),
+                        found: c.description,
+                        expected: format!("{} (another scene, setting or frame)", options.scene_name),
+                    }
+                    .into())
+                }
+            })?;
+        }
+        let mut job = quadray::job::Job::new(&ctx, &first, variant, bounds).context("render failed")?;
+        for frame in list {
+            let frame_scene = frame.map_or_else(|| scene.clone(), |f| scene.at_frame(f));
+            let mut progress = ProgressBar::new(args.progress);
+            let result = job.render(&frame_scene, &options, &mut |d, t| progress.update(d, t));
+            progress.finish();
+            let result = result.context("render failed")?;
+            if result.resumed_from > 0 {
+                eprintln!("resumed at {} of {} spp", result.resumed_from, frame_scene.image.spp);
+            }
+            let paths: Vec<PathBuf> = match frame {
+                Some(f) => outputs.iter().map(|p| frame_path(p, f)).collect(),
+                None => outputs.clone(),
+            };
+            write_render(&args, &ctx, &frame_scene, variant, &paths, frame, &result.output, result.end)?;
+            if result.end != quadray::job::JobEnd::Complete {
+                interrupted = result.end == quadray::job::JobEnd::Interrupted;
+                break;
+            }
+        }
+    }
+    drop(ctx);
     if counters.errors() > 0 {
-        bail!("the validation layer reported {} error(s); no output written", counters.errors());
+        bail!("the validation layer reported {} error(s) at shutdown", counters.errors());
+    }
+    if interrupted {
+        std::process::exit(EXIT_INTERRUPTED);
+    }
+    Ok(())
+}
+
+/// Writes one render's (or frame's) files with their metadata, handles its
+/// checkpoint and prints what was done.
+#[allow(clippy::too_many_arguments)]
+fn write_render(
+    args: &RenderArgs,
+    ctx: &quadray::vk::Context,
+    scene: &Scene,
+    variant: quadray::passes::RenderVariant,
+    outputs: &[PathBuf],
+    frame: Option<u32>,
+    out: &quadray::passes::RenderOutput,
+    end: quadray::job::JobEnd,
+) -> Result<()> {
+    if ctx.counters().errors() > 0 {
+        bail!("the validation layer reported {} error(s); no output written", ctx.counters().errors());
     }
     let precision = if args.half { ExrPrecision::Half } else { ExrPrecision::Float };
     let files: Vec<(PathBuf, OutputKind)> = outputs
@@ -485,7 +696,45 @@ fn render(args: RenderArgs) -> Result<()> {
             (p.clone(), kind)
         })
         .collect();
-    write_outputs(&out, &files)?;
+    let key = quadray::job::image_key(scene, variant);
+    let mut metadata: Vec<(String, String)> = [
+        (quadray::output::METADATA_SPP, out.spp.to_string()),
+        (quadray::output::METADATA_TARGET_SPP, scene.image.spp.to_string()),
+        (quadray::output::METADATA_SEED, scene.image.seed.to_string()),
+        (quadray::output::METADATA_EXPOSURE, scene.image.exposure.to_string()),
+        (quadray::output::METADATA_SCENE_KEY, format!("{key:016x}")),
+    ]
+    .map(|(k, v)| (k.to_string(), v))
+    .to_vec();
+    if let Some(f) = frame {
+        metadata.push((quadray::output::METADATA_FRAME.to_string(), f.to_string()));
+    }
+    write_outputs_with(out, &files, &metadata)?;
+    let checkpoint = args.checkpoint.as_ref().or(args.resume.as_ref());
+    match (end, checkpoint) {
+        (quadray::job::JobEnd::Complete, Some(path)) if path.exists() => {
+            // The images are the render now; a checkpoint left behind would
+            // only be resumed into the same images.
+            std::fs::remove_file(path).with_context(|| format!("cannot remove {}", path.display()))?;
+        }
+        (quadray::job::JobEnd::Complete, _) => {}
+        (stopped, path) => eprintln!(
+            "{}: wrote the image so far ({} spp of {}{}){}",
+            if stopped == quadray::job::JobEnd::Interrupted { "interrupted" } else { "time limit reached" },
+            out.spp,
+            scene.image.spp,
+            if out.partial_tiles > 0 {
+                format!(", {} tiles of the next sample", out.partial_tiles)
+            } else {
+                String::new()
+            },
+            path.map_or(String::from("; no checkpoint (--checkpoint PATH would keep the work)"), |p| format!(
+                "; checkpoint {} (continue with --resume {})",
+                p.display(),
+                p.display()
+            ))
+        ),
+    }
     if let Some(c) = &out.caustics {
         eprintln!(
             "caustics: {} rays in {} grid(s), {} landed on a receiver; {:.3} s (G-buffer {:.3}, rays {:.3}, cells {:.3}, beams {:.3})",
@@ -520,10 +769,34 @@ fn render(args: RenderArgs) -> Result<()> {
         out.seconds,
         ctx.device.name
     );
-    drop(ctx);
-    if counters.errors() > 0 {
-        bail!("the validation layer reported {} error(s) at shutdown", counters.errors());
-    }
+    Ok(())
+}
+
+/// `quadray merge`: tiles into the whole frame.
+fn merge(args: MergeArgs) -> Result<()> {
+    let tiles =
+        args.tiles.iter().map(|p| Ok((p.clone(), quadray::output::read_render_exr(p)?))).collect::<Result<Vec<_>>>()?;
+    let (out, metadata) = quadray::merge::merge(&tiles)?;
+    let exposure = metadata
+        .iter()
+        .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
+        .and_then(|(_, v)| v.parse().ok())
+        .unwrap_or(0.0);
+    let precision = if args.half { ExrPrecision::Half } else { ExrPrecision::Float };
+    let files: Vec<(PathBuf, OutputKind)> = output_paths(&args.output)
+        .into_iter()
+        .map(|p| {
+            let kind = if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
+                OutputKind::Png { exposure }
+            } else {
+                OutputKind::Exr(precision)
+            };
+            (p, kind)
+        })
+        .collect();
+    write_outputs_with(&out, &files, &metadata)?;
+    let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
+    eprintln!("merged {} tiles into {} ({}x{}, {} spp)", tiles.len(), names.join(", "), out.width, out.height, out.spp);
     Ok(())
 }
 
@@ -976,6 +1249,7 @@ fn main() -> Result<()> {
         Some(Command::Bench(args)) => bench_presets(args),
         Some(Command::View(args)) => view(args),
         Some(Command::Throughput(args)) => throughput(args, set_threads),
+        Some(Command::Merge(args)) => merge(args),
         None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),
     }
 }

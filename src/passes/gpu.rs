@@ -335,7 +335,7 @@ pub struct GpuFrame {
 
 /// `Aov` in render.comp.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuAov {
     /// Distance along the normalised pixel-centre ray (infinity on a miss).
     pub depth: f32,

@@ -1,7 +1,9 @@
 //! GPU passes, one a file: the scene upload, the render pass, and the probe
 //! passes (rays, texture lookups) used by tests and benchmarks.
 
+pub mod bounds;
 pub mod caustics;
+pub mod checkpoint;
 pub mod gpu;
 pub mod outliers;
 pub mod probe;
@@ -10,7 +12,9 @@ pub mod scene_gpu;
 pub mod texprobe;
 pub mod volume;
 
+pub use bounds::{PixelBounds, TileIndex};
 pub use caustics::{CausticMap, CausticReport};
+pub use checkpoint::{Accumulation, Checkpoint};
 pub use probe::ProbePass;
 pub use render::{render, RecordedPath, RenderOutput, RenderVariant, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene};

@@ -4,7 +4,9 @@
 
 use std::sync::Arc;
 
+use super::bounds::PixelBounds;
 use super::caustics::{emitters, CausticMap, CausticReport};
+use super::checkpoint::Accumulation;
 use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::volume::VolumeLight;
@@ -19,20 +21,30 @@ use crate::vk::{
 use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
-const TILE: u32 = 256;
+pub const TILE: u32 = 256;
 
-/// What a render produces: linear radiance and AOVs, row 0 at the top.
+/// What a render produces: linear radiance and AOVs, row 0 at the top, for
+/// the pixels of `bounds` (the whole frame, or a crop or tile of it).
 pub struct RenderOutput {
-    /// Width in pixels.
+    /// Width in pixels (of `bounds`).
     pub width: u32,
-    /// Height in pixels.
+    /// Height in pixels (of `bounds`).
     pub height: u32,
+    /// The part of the frame the image covers.
+    pub bounds: PixelBounds,
+    /// The whole frame's width and height.
+    pub frame_size: (u32, u32),
     /// Mean radiance per pixel (linear RGB).
     pub radiance: Vec<[f32; 3]>,
     /// Depth, normal and albedo per pixel from the pixel-centre ray.
     pub aov: Vec<GpuAov>,
-    /// Samples per pixel taken.
+    /// Samples per pixel taken (every pixel has at least this many; an
+    /// interrupted render's pixels in the tiles of its next sample that
+    /// finished have one more, see `partial_tiles`).
     pub spp: u32,
+    /// Tiles of sample `spp` that were finished when the render stopped
+    /// (0 for a render that ran to the end).
+    pub partial_tiles: u32,
     /// GPU time of the work in seconds (timestamps), the caustic and volume
     /// passes included.
     pub seconds: f64,
@@ -58,9 +70,12 @@ impl RenderOutput {
         Self {
             width,
             height,
+            bounds: PixelBounds::full(width, height),
+            frame_size: (width, height),
             radiance,
             aov: vec![],
             spp: 0,
+            partial_tiles: 0,
             seconds: 0.0,
             render_seconds: 0.0,
             caustics: None,
@@ -137,11 +152,7 @@ pub fn render(
     let mut renderer = Renderer::new(device, cmds, gpu, scene, (width, height, spp), variant)?;
     renderer.add_samples(cmds, spp, progress)?;
     let mut out = renderer.output(cmds)?;
-    if let (Some(report), Some(map)) = (&mut out.caustics, &mut renderer.caustics) {
-        map.read_statistics();
-        report.landed = map.report.landed;
-        report.irradiance = std::mem::take(&mut map.report.irradiance);
-    }
+    renderer.read_caustic_statistics(&mut out);
     Ok(out)
 }
 
@@ -216,6 +227,7 @@ fn gpu_frame(scene: &Scene, gpu: &GpuScene, width: u32, height: u32, spp: u32) -
 pub struct Renderer {
     // Pipelines first: dropped before the buffers their descriptors name.
     pipeline: ComputePipeline,
+    device: Arc<Device>,
     caustics: Option<CausticMap>,
     volume: Option<VolumeLight>,
     frame: Buffer,
@@ -228,7 +240,10 @@ pub struct Renderer {
     aov: Buffer,
     timer: GpuTimer,
     tiles: Vec<[u32; 4]>,
+    // Tiles of sample `samples` already added (an interrupted sample).
+    tiles_done: usize,
     size: (u32, u32),
+    bounds: PixelBounds,
     // The samples per pixel the render was made for (the footprints' share).
     spp: u32,
     volume_samples: u32,
@@ -248,6 +263,23 @@ impl Renderer {
         (width, height, spp): (u32, u32, u32),
         variant: RenderVariant,
     ) -> Result<Self, RenderError> {
+        Self::with_bounds(device, cmds, gpu, scene, (width, height, spp), PixelBounds::full(width, height), variant)
+    }
+
+    /// [`Renderer::new`] for the pixels of `bounds` alone (a crop or tile
+    /// of the `width` x `height` frame): samples are taken only there, with
+    /// the same random numbers as in a render of the whole frame. The
+    /// caustic and volume passes still cover the whole frame.
+    pub fn with_bounds(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        gpu: &GpuScene,
+        scene: &Scene,
+        (width, height, spp): (u32, u32, u32),
+        bounds: PixelBounds,
+        variant: RenderVariant,
+    ) -> Result<Self, RenderError> {
+        let bounds = bounds.check(width, height)?;
         let pixels = width as u64 * height as u64;
         let frame = Buffer::with_data(
             device,
@@ -328,14 +360,14 @@ impl Renderer {
             accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
             max_sample.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
         })?;
-        let tiles = (0..height)
+        let PixelBounds { x0, x1, y0, y1 } = bounds;
+        let tiles = (y0..y1)
             .step_by(TILE as usize)
-            .flat_map(|y| {
-                (0..width).step_by(TILE as usize).map(move |x| [x, y, TILE.min(width - x), TILE.min(height - y)])
-            })
+            .flat_map(|y| (x0..x1).step_by(TILE as usize).map(move |x| [x, y, TILE.min(x1 - x), TILE.min(y1 - y)]))
             .collect();
         let mut renderer = Self {
             pipeline,
+            device: device.clone(),
             caustics,
             volume,
             frame,
@@ -347,7 +379,9 @@ impl Renderer {
             aov,
             timer: GpuTimer::new(device)?,
             tiles,
+            tiles_done: 0,
             size: (width, height),
+            bounds,
             spp,
             volume_samples: scene.volume.samples.saturating_mul(spp),
             samples: 0,
@@ -382,6 +416,7 @@ impl Renderer {
             max_sample.clear(cmd);
         })?;
         self.samples = 0;
+        self.tiles_done = 0;
         self.render_seconds = 0.0;
         Ok(())
     }
@@ -412,33 +447,169 @@ impl Renderer {
     /// Adds `count` samples per pixel, one dispatch per tile and sample,
     /// reporting progress in tile-samples.
     pub fn add_samples(&mut self, cmds: &mut Commands, count: u32, progress: Progress<'_>) -> Result<(), RenderError> {
-        let total = self.tiles.len() as u64 * count as u64;
+        let target = self.samples + count;
+        self.add_samples_until(cmds, target, progress, &mut || false)?;
+        Ok(())
+    }
+
+    /// Adds samples until `target` samples per pixel are accumulated, one
+    /// dispatch per tile and sample, reporting progress in tile-samples
+    /// (of the work left when called). `stop` is asked after every dispatch;
+    /// when it says so, the render stops there (between two tiles of a
+    /// sample, maybe) and returns false: [`Renderer::accumulation`] then
+    /// holds the work so far, and [`Renderer::restore`] continues it as if
+    /// nothing had happened. Returns true when `target` is reached.
+    pub fn add_samples_until(
+        &mut self,
+        cmds: &mut Commands,
+        target: u32,
+        progress: Progress<'_>,
+        stop: &mut dyn FnMut() -> bool,
+    ) -> Result<bool, RenderError> {
+        let tiles = self.tiles.len() as u64;
+        let total = (tiles * target as u64).saturating_sub(tiles * self.samples as u64 + self.tiles_done as u64);
         let mut done = 0;
-        for sample in self.samples..self.samples + count {
-            for t in &self.tiles {
-                let push = RenderPush {
-                    tile_origin: [t[0], t[1]],
-                    tile_size: [t[2], t[3]],
-                    sample_index: sample,
-                    write_aov: (sample == 0) as u32,
-                };
-                let pipeline = &self.pipeline;
-                let ((), seconds) = self.timer.run(cmds, |d, cmd| {
-                    // Earlier submissions' writes to the accumulation image must be visible.
-                    full_barrier(d, cmd);
-                    pipeline.dispatch(
-                        cmd,
-                        bytemuck::bytes_of(&push),
-                        [t[2].div_ceil(RENDER_GROUP), t[3].div_ceil(RENDER_GROUP), 1],
-                    )
-                })?;
-                self.render_seconds += seconds;
-                done += 1;
-                progress(done, total);
+        while self.samples < target {
+            let t = self.tiles[self.tiles_done];
+            let push = RenderPush {
+                tile_origin: [t[0], t[1]],
+                tile_size: [t[2], t[3]],
+                sample_index: self.samples,
+                write_aov: (self.samples == 0) as u32,
+            };
+            let pipeline = &self.pipeline;
+            let ((), seconds) = self.timer.run(cmds, |d, cmd| {
+                // Earlier submissions' writes to the accumulation image must be visible.
+                full_barrier(d, cmd);
+                pipeline.dispatch(
+                    cmd,
+                    bytemuck::bytes_of(&push),
+                    [t[2].div_ceil(RENDER_GROUP), t[3].div_ceil(RENDER_GROUP), 1],
+                )
+            })?;
+            self.render_seconds += seconds;
+            self.tiles_done += 1;
+            if self.tiles_done == self.tiles.len() {
+                self.tiles_done = 0;
+                self.samples += 1;
+            }
+            done += 1;
+            progress(done, total);
+            if self.samples < target && stop() {
+                return Ok(false);
             }
         }
-        self.samples += count;
+        Ok(true)
+    }
+
+    /// Tiles of the next sample already added (non-zero only after
+    /// [`Renderer::add_samples_until`] stopped early).
+    pub fn partial_tiles(&self) -> u32 {
+        self.tiles_done as u32
+    }
+
+    /// The pixels of `bounds` and the number of samples each has: `samples`,
+    /// plus one in the tiles of the interrupted next sample that finished.
+    fn sample_counts(&self) -> Vec<u32> {
+        let b = self.bounds;
+        let mut counts = vec![self.samples; b.pixels()];
+        for t in &self.tiles[..self.tiles_done] {
+            for y in t[1]..t[1] + t[3] {
+                for x in t[0]..t[0] + t[2] {
+                    counts[((y - b.y0) * b.width() + x - b.x0) as usize] += 1;
+                }
+            }
+        }
+        counts
+    }
+
+    /// The work so far, as a checkpoint stores it: the accumulation's sums
+    /// and finite-sample counts, the largest samples and the AOVs, for the
+    /// pixels of the renderer's bounds.
+    pub fn accumulation(&mut self, cmds: &mut Commands) -> Result<Accumulation, RenderError> {
+        let (width, _) = self.size;
+        let pixels = (self.size.0 * self.size.1) as usize;
+        let sums: Vec<[f32; 4]> = self.read_image(cmds, &self.accum)?;
+        let max_sample: Vec<[f32; 2]> = self.read_image(cmds, &self.max_sample)?;
+        let aov: Vec<GpuAov> = self.aov.read();
+        Ok(Accumulation {
+            frame_size: self.size,
+            bounds: self.bounds,
+            samples: self.samples,
+            partial_tiles: self.tiles_done as u32,
+            render_seconds: self.render_seconds,
+            sums: self.bounds.extract(&sums[..pixels], width),
+            max_sample: self.bounds.extract(&max_sample[..pixels], width),
+            aov: self.bounds.extract(&aov[..pixels], width),
+        })
+    }
+
+    /// Continues from `acc` (of a renderer with the same frame, bounds and
+    /// scene): its sums, largest samples and AOVs are uploaded and the next
+    /// sample is the one it stopped at, so that the render goes on with the
+    /// same random numbers and the same order of additions.
+    pub fn restore(&mut self, cmds: &mut Commands, acc: &Accumulation) -> Result<(), RenderError> {
+        let (width, height) = self.size;
+        let pixels = (width * height) as usize;
+        let n = self.bounds.pixels();
+        if acc.frame_size != self.size
+            || acc.bounds != self.bounds
+            || acc.partial_tiles as usize >= self.tiles.len()
+            || [acc.sums.len(), acc.max_sample.len(), acc.aov.len()] != [n; 3]
+        {
+            return Err(RenderError::Accumulation(format!(
+                "{}x{} frame, bounds {}, {} tiles a sample; the accumulation has a {}x{} frame, bounds {}, {} \
+                 tiles done",
+                width,
+                height,
+                self.bounds,
+                self.tiles.len(),
+                acc.frame_size.0,
+                acc.frame_size.1,
+                acc.bounds,
+                acc.partial_tiles
+            )));
+        }
+        let mut sums = vec![[0f32; 4]; pixels];
+        self.bounds.insert(&acc.sums, &mut sums, width);
+        let mut largest = vec![[0f32; 2]; pixels];
+        self.bounds.insert(&acc.max_sample, &mut largest, width);
+        let mut aov: Vec<GpuAov> = self.aov.read();
+        self.bounds.insert(&acc.aov, &mut aov[..pixels], width);
+        self.aov.write(0, bytemuck::cast_slice(&aov));
+        let mut staging = Buffer::new(
+            &self.device,
+            "accumulation upload",
+            pixels as u64 * 24,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        staging.write(0, bytemuck::cast_slice(&sums));
+        staging.write(pixels * 16, bytemuck::cast_slice(&largest));
+        let (accum, max_sample) = (&self.accum, &self.max_sample);
+        cmds.run(|d, cmd| {
+            full_barrier(d, cmd);
+            for (image, offset) in [(accum, 0), (max_sample, pixels as u64 * 16)] {
+                image.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+                image.copy_from_buffer(cmd, &staging, &[image.rows_region(0, 0, height, offset)]);
+                image.transition(cmd, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::GENERAL);
+            }
+            full_barrier(d, cmd);
+        })?;
+        self.samples = acc.samples;
+        self.tiles_done = acc.partial_tiles as usize;
+        self.render_seconds = acc.render_seconds;
         Ok(())
+    }
+
+    /// Fills the caustic report of `out` with the statistics the caustic
+    /// passes keep on the GPU (rays landed, the irradiance deposited).
+    pub fn read_caustic_statistics(&mut self, out: &mut RenderOutput) {
+        if let (Some(report), Some(map)) = (&mut out.caustics, &mut self.caustics) {
+            map.read_statistics();
+            report.landed = map.report.landed;
+            report.irradiance = std::mem::take(&mut map.report.irradiance);
+        }
     }
 
     /// Copies `image` (one of the renderer's, in GENERAL layout) into the
@@ -456,33 +627,15 @@ impl Renderer {
         Ok(readback.read())
     }
 
-    /// Reads back the mean of the samples so far, the AOVs and the times.
+    /// Reads back the mean of the samples so far, the AOVs and the times,
+    /// for the pixels of the renderer's bounds.
     pub fn output(&mut self, cmds: &mut Commands) -> Result<RenderOutput, RenderError> {
-        let (width, height) = self.size;
-        let pixels = width as usize * height as usize;
-        let sums: Vec<[f32; 4]> = self.read_image(cmds, &self.accum)?;
-        // The fourth channel counts the finite samples; the mean is over
-        // all samples, the dropped ones black.
-        let n = self.samples.max(1) as f32;
-        let radiance = sums[..pixels].iter().map(|s| [s[0] / n, s[1] / n, s[2] / n]).collect();
-        let dropped_samples =
-            sums[..pixels].iter().map(|s| (self.samples as f64 - s[3] as f64).round().max(0.0) as u64).sum();
-        let mut max_sample: Vec<[f32; 2]> = self.read_image(cmds, &self.max_sample)?;
-        max_sample.truncate(pixels);
-        let mut aov: Vec<GpuAov> = self.aov.read();
-        aov.truncate(pixels);
+        let acc = self.accumulation(cmds)?;
         Ok(RenderOutput {
-            width,
-            height,
-            radiance,
-            aov,
-            spp: self.samples,
-            seconds: self.seconds(),
-            render_seconds: self.render_seconds,
             caustics: self.caustics.as_ref().map(|c| CausticReport { irradiance: Vec::new(), ..c.report.clone() }),
             volume_seconds: self.volume_seconds(),
-            dropped_samples,
-            max_sample,
+            seconds: self.seconds(),
+            ..acc.output(&self.sample_counts())
         })
     }
 

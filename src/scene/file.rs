@@ -32,9 +32,9 @@ use toml::Spanned;
 use crate::hash::hash_unit;
 
 use super::{
-    Camera, CausticSettings, ConductorFresnel, EnvironmentMapSettings, FilterMode, ImageSettings, Light, Material,
-    MaterialKind, MaterialMaps, Medium, Preset, Quality, Scene, SceneObject, TextureImage, UvMapping, UvSettings,
-    VolumeSettings,
+    Camera, CameraKeyframe, CausticSettings, ConductorFresnel, EnvironmentMapSettings, FilterMode, ImageSettings,
+    Light, Material, MaterialKind, MaterialMaps, Medium, Preset, Quality, Scene, SceneObject, TextureImage, UvMapping,
+    UvSettings, VolumeSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 use crate::sampling::envmap::procedural_sky;
@@ -812,6 +812,18 @@ struct RawCamera {
     look_at: Spanned<Triple<Finite>>,
     up: Option<Spanned<Triple<Finite>>>,
     fov: Option<Fov>,
+    fps: Option<Positive>,
+    keyframes: Option<Vec<Spanned<RawKeyframe>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a [[camera.keyframes]] table with time, position and look_at")]
+struct RawKeyframe {
+    time: Finite,
+    position: Triple<Finite>,
+    look_at: Spanned<Triple<Finite>>,
+    up: Option<Spanned<Triple<Finite>>>,
+    fov: Option<Fov>,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Debug)]
@@ -1253,34 +1265,64 @@ fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneError> {
 
 fn build_camera(src: &Source, raw: &Spanned<RawCamera>) -> Result<Camera, SceneError> {
     let c = raw.get_ref();
-    let position = c.position.get();
-    let look_at = c.look_at.get_ref().get();
-    let up = c.up.as_ref().map_or(DVec3::Y, |u| u.get_ref().get());
+    let (position, look_at, up) = check_view(src, "camera", raw.span(), (c.position.get(), &c.look_at, c.up.as_ref()))?;
+    let fov = c.fov.map_or(40.0, |f| f.get());
+    let mut keyframes: Vec<CameraKeyframe> = Vec::new();
+    for (i, k) in c.keyframes.iter().flatten().enumerate() {
+        let name = format!("camera.keyframes[{i}]");
+        let r = k.get_ref();
+        let (position, look_at, up) = check_view(src, &name, k.span(), (r.position.get(), &r.look_at, r.up.as_ref()))?;
+        let time = r.time.get();
+        if keyframes.last().is_some_and(|p| p.time >= time) {
+            return Err(src.error(Some(k.span()), format!("{name}.time"), "must be later than the keyframe before"));
+        }
+        // A keyframe's fov defaults to the camera's.
+        keyframes.push(CameraKeyframe { time, position, look_at, up, vfov_degrees: r.fov.map_or(fov, |f| f.get()) });
+    }
+    Ok(Camera { position, look_at, up, vfov_degrees: fov, keyframes, fps: c.fps.map_or(24.0, |f| f.get()) })
+}
+
+/// A view as written: position, look_at and up (optional).
+type RawView<'a> = (DVec3, &'a Spanned<Triple<Finite>>, Option<&'a Spanned<Triple<Finite>>>);
+
+/// Checks a view (position, look_at, up) of the camera or of a keyframe
+/// (`name`: where, in messages) and returns it with the default up.
+fn check_view(
+    src: &Source,
+    name: &str,
+    span: std::ops::Range<usize>,
+    (position, look_at, up): RawView<'_>,
+) -> Result<(DVec3, DVec3, DVec3), SceneError> {
+    let c_look_at = look_at;
+    let look_at = c_look_at.get_ref().get();
+    let up_value = up.map_or(DVec3::Y, |u| u.get_ref().get());
     let view = look_at - position;
     let scale = position.abs().max(look_at.abs()).max_element().max(1.0);
     if view.length() <= 1e-9 * scale {
         return Err(src.error(
-            Some(c.look_at.span()),
-            "camera.look_at",
-            "must differ from camera.position (the view direction is look_at - position)",
+            Some(c_look_at.span()),
+            format!("{name}.look_at"),
+            format!("must differ from {name}.position (the view direction is look_at - position)"),
         ));
     }
-    let (up_span, default_note) = match &c.up {
+    let default_note = format!(" (the default up is [0, 1, 0]; set {name}.up)");
+    let (up_span, default_note) = match up {
         Some(u) => (u.span(), ""),
-        None => (raw.span(), " (the default up is [0, 1, 0]; set camera.up)"),
+        None => (span, default_note.as_str()),
     };
+    let up = up_value;
     if up.length() == 0.0 {
-        return Err(src.error(Some(up_span), "camera.up", "must not be zero"));
+        return Err(src.error(Some(up_span), format!("{name}.up"), "must not be zero"));
     }
     let sin = view.normalize().cross(up.normalize()).length();
     if sin < 1e-6 {
         return Err(src.error(
             Some(up_span),
-            "camera.up",
+            format!("{name}.up"),
             format!("must not be parallel to the view direction look_at - position{default_note}"),
         ));
     }
-    Ok(Camera { position, look_at, up, vfov_degrees: c.fov.map_or(40.0, |f| f.get()) })
+    Ok((position, look_at, up))
 }
 
 /// The shape keys of an object, in the order they are listed in messages.
@@ -2582,13 +2624,30 @@ mod tests {
     }
 
     #[test]
+    fn camera_keyframes_interpolate_and_must_increase() {
+        let text = "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfps = 2\n\
+                    [[camera.keyframes]]\ntime = 0\nposition = [0, 0, 4]\nlook_at = [0, 0, 0]\n\
+                    [[camera.keyframes]]\ntime = 1\nposition = [2, 0, 4]\nlook_at = [0, 0, 0]\nfov = 60\n";
+        let s = parse_scene(text, "t").unwrap();
+        assert_eq!(s.camera.keyframes.len(), 2);
+        assert_eq!(s.camera.keyframes[0].vfov_degrees, 40.0);
+        // Frame 1 at 2 fps: halfway.
+        let c = s.camera.at_frame(1);
+        assert_eq!((c.position, c.vfov_degrees), (DVec3::new(1.0, 0.0, 4.0), 50.0));
+        assert_eq!(s.camera.at_frame(7).position, DVec3::new(2.0, 0.0, 4.0));
+        assert_eq!(s.camera.render_origin(), DVec3::new(0.0, 0.0, 4.0));
+        let e = parse_scene(&text.replace("time = 1", "time = 0"), "t").unwrap_err().to_string();
+        assert!(e.contains("camera.keyframes[1].time") && e.contains("later"), "{e}");
+        let e =
+            parse_scene(&text.replace("position = [2, 0, 4]", "position = [0, 0, 0]"), "t").unwrap_err().to_string();
+        assert!(e.contains("camera.keyframes[1].look_at"), "{e}");
+    }
+
+    #[test]
     fn camera() {
         let s = parse_scene("[camera]\nposition = [1, 2, 3]\nlook_at = [0, 1, 0]\nup = [0, 0, 1]\nfov = 60\n", "t")
             .unwrap();
-        assert_eq!(
-            s.camera,
-            Camera { position: DVec3::new(1.0, 2.0, 3.0), look_at: DVec3::Y, up: DVec3::Z, vfov_degrees: 60.0 }
-        );
+        assert_eq!(s.camera, Camera::still(DVec3::new(1.0, 2.0, 3.0), DVec3::Y, DVec3::Z, 60.0));
     }
 
     #[test]

@@ -23,6 +23,69 @@ pub struct Camera {
     pub up: DVec3,
     /// Vertical field of view in degrees.
     pub vfov_degrees: f64,
+    /// Camera keyframes (`[[camera.keyframes]]`), in increasing time; empty
+    /// for a still camera. [`Scene::at_frame`] interpolates them.
+    pub keyframes: Vec<CameraKeyframe>,
+    /// Frames per second of the animation (`camera.fps`, default 24):
+    /// frame F is at time F / fps.
+    pub fps: f64,
+}
+
+/// A camera keyframe: where the camera is at `time` seconds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraKeyframe {
+    /// Time in seconds.
+    pub time: f64,
+    /// Eye position.
+    pub position: DVec3,
+    /// The point looked at.
+    pub look_at: DVec3,
+    /// Up direction.
+    pub up: DVec3,
+    /// Vertical field of view in degrees.
+    pub vfov_degrees: f64,
+}
+
+impl Camera {
+    /// A still camera (no keyframes, 24 frames per second).
+    pub fn still(position: DVec3, look_at: DVec3, up: DVec3, vfov_degrees: f64) -> Self {
+        Self { position, look_at, up, vfov_degrees, keyframes: Vec::new(), fps: 24.0 }
+    }
+
+    /// The camera at frame `frame`: its keyframes interpolated linearly
+    /// (position, look_at, up and fov) at time frame / fps, held before the
+    /// first and after the last; itself when it has no keyframes.
+    pub fn at_frame(&self, frame: u32) -> Self {
+        let (Some(first), Some(last)) = (self.keyframes.first(), self.keyframes.last()) else {
+            return self.clone();
+        };
+        let t = frame as f64 / self.fps;
+        let (a, b, s) = if t <= first.time {
+            (first, first, 0.0)
+        } else if t >= last.time {
+            (last, last, 0.0)
+        } else {
+            let i = self.keyframes.partition_point(|k| k.time <= t);
+            let (a, b) = (&self.keyframes[i - 1], &self.keyframes[i]);
+            (a, b, (t - a.time) / (b.time - a.time))
+        };
+        Self {
+            position: a.position.lerp(b.position, s),
+            look_at: a.look_at.lerp(b.look_at, s),
+            up: a.up.lerp(b.up, s),
+            vfov_degrees: a.vfov_degrees + (b.vfov_degrees - a.vfov_degrees) * s,
+            keyframes: self.keyframes.clone(),
+            fps: self.fps,
+        }
+    }
+
+    /// The origin of the GPU scene's coordinates for renders of this camera:
+    /// the first keyframe's position for an animated camera (the same in
+    /// every frame, so that a frame renders the same alone or in a range),
+    /// else the camera's position.
+    pub fn render_origin(&self) -> DVec3 {
+        self.keyframes.first().map_or(self.position, |k| k.position)
+    }
 }
 
 /// Image size, sampling and exposure.
@@ -352,6 +415,14 @@ impl Light {
 }
 
 impl Scene {
+    /// The scene at frame `frame` of its camera animation (the camera
+    /// interpolated, [`Camera::at_frame`]); a copy of it for a still camera.
+    pub fn at_frame(&self, frame: u32) -> Self {
+        let mut s = self.clone();
+        s.camera = self.camera.at_frame(frame);
+        s
+    }
+
     /// True when some medium (the fog, or a dielectric's interior) has a
     /// positive density: the render shader's media code is compiled out
     /// otherwise.

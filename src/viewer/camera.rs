@@ -106,7 +106,7 @@ mod tests {
     use super::*;
 
     fn camera() -> Camera {
-        Camera { position: DVec3::new(0.0, 1.0, 5.0), look_at: DVec3::ZERO, up: DVec3::Y, vfov_degrees: 40.0 }
+        Camera::still(DVec3::new(0.0, 1.0, 5.0), DVec3::ZERO, DVec3::Y, 40.0)
     }
 
     #[test]

@@ -1,0 +1,217 @@
+//! A long render as a job: rendered to its sample count, or stopped by a
+//! signal or a time budget with its work kept, checkpointed on the way and
+//! resumable (`quadray render --checkpoint/--resume/--time-limit`).
+//!
+//! Stopping happens between two dispatches (one tile of one sample): the
+//! dispatch in flight finishes, then the accumulation is read back. A
+//! resumed render restores it and goes on from the same tile and sample,
+//! so its image is bit-identical to an uninterrupted render's.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::passes::checkpoint::{render_key, Checkpoint, CheckpointError};
+use crate::passes::{GpuScene, PixelBounds, RenderOutput, RenderVariant, Renderer};
+use crate::scene::Scene;
+use crate::{geometry, vk, RenderError};
+
+/// How a job renders and when it stops.
+#[derive(Clone, Debug)]
+pub struct JobOptions {
+    /// The pixels to render (a crop or tile, or the whole frame).
+    pub bounds: PixelBounds,
+    /// Where to write checkpoints (none: no checkpoints).
+    pub checkpoint: Option<PathBuf>,
+    /// Time between checkpoints.
+    pub checkpoint_every: Duration,
+    /// A checkpoint to continue from.
+    pub resume: Option<PathBuf>,
+    /// Stop after this much wall time (from the job's start).
+    pub time_limit: Option<Duration>,
+    /// Set (by a signal handler) to stop at the next dispatch boundary.
+    pub stop: Arc<AtomicBool>,
+    /// A name for the scene in checkpoint descriptions (its file).
+    pub scene_name: String,
+}
+
+/// How a job ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JobEnd {
+    /// Every sample rendered.
+    Complete,
+    /// Stopped by [`JobOptions::stop`] (a signal).
+    Interrupted,
+    /// Stopped by [`JobOptions::time_limit`].
+    TimeLimit,
+}
+
+/// Why a job failed.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    /// The render failed.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// A checkpoint could not be read, used or written.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+}
+
+/// What a finished or stopped job has.
+pub struct JobResult {
+    /// The image so far (the whole render when `end` is `Complete`).
+    pub output: RenderOutput,
+    /// How the job ended.
+    pub end: JobEnd,
+    /// The samples per pixel the job resumed from (0 when it started afresh).
+    pub resumed_from: u32,
+    /// The checkpoint key ([`render_key`] of the scene and settings).
+    pub key: u64,
+}
+
+/// A description of a render for checkpoint messages.
+fn describe(scene: &Scene, name: &str, bounds: PixelBounds) -> String {
+    let im = &scene.image;
+    format!(
+        "{name}, {}x{} pixels{}, {} spp, seed {}",
+        im.width,
+        im.height,
+        if bounds.is_full(im.width, im.height) { String::new() } else { format!(" (bounds {bounds})") },
+        im.spp,
+        im.seed
+    )
+}
+
+/// The checkpoint key of `scene` rendered with `variant` over `bounds`.
+pub fn job_key(scene: &Scene, variant: RenderVariant, bounds: PixelBounds) -> u64 {
+    render_key(scene, &(variant, bounds))
+}
+
+/// The key the images of `scene` rendered with `variant` carry (any pixel
+/// bounds): tiles merge only with tiles of the same key.
+pub fn image_key(scene: &Scene, variant: RenderVariant) -> u64 {
+    render_key(scene, &variant)
+}
+
+/// The GPU state of a job: the scene uploaded and the passes built once,
+/// then reused for every frame a process renders (lavapipe compiles each
+/// shader at its first dispatch, which would otherwise be paid per frame).
+pub struct Job {
+    // The renderer first: dropped before the scene its descriptors name.
+    renderer: Renderer,
+    gpu: GpuScene,
+    cmds: vk::Commands,
+    variant: RenderVariant,
+    bounds: PixelBounds,
+    // Whether the renderer is at the camera of the scene it was built with.
+    fresh: bool,
+}
+
+impl Job {
+    /// Uploads `scene` (its objects, materials and lights: every frame
+    /// renders these) and builds the passes for `bounds` of its frame.
+    pub fn new(
+        ctx: &vk::Context,
+        scene: &Scene,
+        variant: RenderVariant,
+        bounds: PixelBounds,
+    ) -> Result<Self, JobError> {
+        let im = &scene.image;
+        let mut cmds = vk::Commands::new(&ctx.device).map_err(RenderError::from)?;
+        let gpu = GpuScene::with_origin(
+            &ctx.device,
+            &mut cmds,
+            scene,
+            &geometry::CellParams::default(),
+            scene.camera.render_origin(),
+        )?;
+        let renderer =
+            Renderer::with_bounds(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), bounds, variant)?;
+        Ok(Self { renderer, gpu, cmds, variant, bounds, fresh: true })
+    }
+
+    /// Renders `scene` (the job's scene, or another frame of it: the same
+    /// objects, another camera) as [`run`] does.
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        options: &JobOptions,
+        progress: &mut dyn FnMut(u64, u64),
+    ) -> Result<JobResult, JobError> {
+        let start = Instant::now();
+        let im = &scene.image;
+        let key = job_key(scene, self.variant, self.bounds);
+        let description = describe(scene, &options.scene_name, self.bounds);
+        let resume = options.resume.as_deref().map(|p| Checkpoint::read_for(p, key, &description)).transpose()?;
+        let (renderer, cmds) = (&mut self.renderer, &mut self.cmds);
+        if !self.fresh {
+            renderer.set_camera(cmds, &self.gpu, scene)?;
+        }
+        self.fresh = false;
+        let resumed_from = match &resume {
+            Some(c) => {
+                renderer.restore(cmds, &c.accumulation)?;
+                c.accumulation.samples
+            }
+            None => 0,
+        };
+        let checkpoint = |renderer: &mut Renderer, cmds: &mut vk::Commands| -> Result<(), JobError> {
+            if let Some(path) = &options.checkpoint {
+                let accumulation = renderer.accumulation(cmds)?;
+                Checkpoint { key, target_spp: im.spp, description: description.clone(), accumulation }.write(path)?;
+            }
+            Ok(())
+        };
+        let tiles_per_sample = {
+            let b = self.bounds;
+            let tile = crate::passes::render::TILE as u64;
+            (b.width() as u64).div_ceil(tile) * (b.height() as u64).div_ceil(tile)
+        };
+        let total = tiles_per_sample * im.spp as u64;
+        let mut last_checkpoint = Instant::now();
+        let end = loop {
+            let base = tiles_per_sample * renderer.samples() as u64 + renderer.partial_tiles() as u64;
+            let mut why = None;
+            let done = renderer.add_samples_until(cmds, im.spp, &mut |d, _| progress(base + d, total), &mut || {
+                if options.stop.load(Ordering::SeqCst) {
+                    why = Some(JobEnd::Interrupted);
+                } else if options.time_limit.is_some_and(|limit| start.elapsed() >= limit) {
+                    why = Some(JobEnd::TimeLimit);
+                }
+                why.is_some() || (options.checkpoint.is_some() && last_checkpoint.elapsed() >= options.checkpoint_every)
+            })?;
+            if done {
+                break JobEnd::Complete;
+            }
+            checkpoint(renderer, cmds)?;
+            last_checkpoint = Instant::now();
+            if let Some(end) = why {
+                break end;
+            }
+        };
+        let mut output = renderer.output(cmds)?;
+        renderer.read_caustic_statistics(&mut output);
+        Ok(JobResult { output, end, resumed_from, key })
+    }
+}
+
+/// Renders `scene` with `variant` as a job: resumes from
+/// `options.resume`, writes checkpoints every `options.checkpoint_every`,
+/// and stops (writing a last checkpoint) when `options.stop` is set or the
+/// time limit passes. `progress` gets (done, total) in tile-samples of the
+/// whole render.
+pub fn run(
+    ctx: &vk::Context,
+    scene: &Scene,
+    variant: RenderVariant,
+    options: &JobOptions,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<JobResult, JobError> {
+    // A wrong checkpoint is refused before any GPU work.
+    if let Some(path) = &options.resume {
+        let key = job_key(scene, variant, options.bounds);
+        Checkpoint::read_for(path, key, &describe(scene, &options.scene_name, options.bounds))?;
+    }
+    Job::new(ctx, scene, variant, options.bounds)?.render(scene, options, progress)
+}
