@@ -191,3 +191,23 @@ fn a_frame_range_renders_numbered_frames_equal_to_single_frames() {
     let bad: Vec<&str> = base.iter().copied().chain(["--frames", "3-1", "-o", "x"]).collect();
     assert!(fails(&bad, d).contains("a frame range is A-B"));
 }
+
+#[test]
+fn a_time_limit_writes_what_it_has_and_a_checkpoint_to_resume() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["render", "--width", "48", "--height", "32", "--spp", "4000"];
+    let limited: Vec<&str> =
+        base.iter().copied().chain(["--time-limit", "0.5", "--checkpoint", "t.ckpt", "-o", "part"]).collect();
+    let stderr = ok(&limited, d);
+    assert!(stderr.contains("time limit reached: wrote the image so far"), "{stderr}");
+    let part = quadray::output::read_render_exr(&d.join("part.exr")).unwrap();
+    let meta = |k: &str| part.metadata.iter().find(|(n, _)| n == k).map(|(_, v)| v.clone());
+    println!("time limit 0.5 s: {} of 4000 spp", part.output.spp);
+    assert!(part.output.spp < 4000);
+    assert_eq!(meta("quadray.spp"), Some(part.output.spp.to_string()));
+    assert_eq!(meta("quadray.target_spp"), Some("4000".to_string()));
+    let checkpoint = quadray::passes::Checkpoint::read(&d.join("t.ckpt")).unwrap();
+    assert_eq!(checkpoint.accumulation.samples, part.output.spp);
+    assert_eq!(checkpoint.target_spp, 4000);
+}
