@@ -13,7 +13,6 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::CellParams;
 use crate::metrics::{flip_mean, relative_mse, MetricError};
 use crate::output::{write_outputs, ExrPrecision, OutputKind};
 use crate::passes::{render, GpuScene, RenderOutput, RenderVariant};
@@ -169,8 +168,7 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
     let mut reports = Vec::new();
     for s in &config.scenes {
         let reference_scene = reference_scene(&s.scene, config);
-        let gpu = GpuScene::with_origin(device, &mut cmds, &s.scene, &CellParams::default(), s.scene.camera.position)
-            .map_err(|e| render_error(&s.name, e))?;
+        let gpu = GpuScene::for_render(device, &mut cmds, &s.scene).map_err(|e| render_error(&s.name, e))?;
         let mut measure = |scene: &Scene, label: &str, bar: &mut ProgressBar, done: &mut u64| {
             bar.set_label(format!("{}: {label}", s.name));
             let variant = RenderVariant { filter: scene.image.filter.constant(), ..Default::default() };

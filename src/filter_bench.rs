@@ -645,7 +645,7 @@ fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result<SceneRepor
     let stem = stem_of(path);
     let exposure = scene.image.exposure;
     let mut cmds = Commands::new(&ctx.device)?;
-    let gpu = GpuScene::with_origin(&ctx.device, &mut cmds, &scene, &CellParams::default(), scene.camera.position)?;
+    let gpu = GpuScene::for_render(&ctx.device, &mut cmds, &scene)?;
     let size = (config.width, config.height);
     let mut bench = Bench { ctx, cmds, gpu, scene, size, shading: config.shading, lookup: config.lookup };
     let seed = bench.scene.image.seed;

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use crate::passes::checkpoint::{render_key, Checkpoint, CheckpointError};
 use crate::passes::{GpuScene, PixelBounds, RenderOutput, RenderVariant, Renderer};
 use crate::scene::Scene;
-use crate::{geometry, vk, RenderError};
+use crate::{vk, RenderError};
 
 /// How a job renders and when it stops.
 #[derive(Clone, Debug)]
@@ -119,13 +119,7 @@ impl Job {
     ) -> Result<Self, JobError> {
         let im = &scene.image;
         let mut cmds = vk::Commands::new(&ctx.device).map_err(RenderError::from)?;
-        let gpu = GpuScene::with_origin(
-            &ctx.device,
-            &mut cmds,
-            scene,
-            &geometry::CellParams::default(),
-            scene.camera.render_origin(),
-        )?;
+        let gpu = GpuScene::for_render(&ctx.device, &mut cmds, scene)?;
         let renderer =
             Renderer::with_bounds(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), bounds, variant)?;
         Ok(Self { renderer, gpu, cmds, variant, bounds, fresh: true })

@@ -84,13 +84,7 @@ pub fn render_scene_with(
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<passes::RenderOutput, RenderError> {
     let mut cmds = vk::Commands::new(&ctx.device)?;
-    let gpu = passes::GpuScene::with_origin(
-        &ctx.device,
-        &mut cmds,
-        scene,
-        &geometry::CellParams::default(),
-        scene.camera.render_origin(),
-    )?;
+    let gpu = passes::GpuScene::for_render(&ctx.device, &mut cmds, scene)?;
     let im = &scene.image;
     passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), variant, progress)
 }

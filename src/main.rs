@@ -828,13 +828,7 @@ fn outliers(args: OutliersArgs) -> Result<()> {
     let counters = ctx.counters();
     let device = &ctx.device;
     let mut cmds = quadray::vk::Commands::new(device)?;
-    let gpu = GpuScene::with_origin(
-        device,
-        &mut cmds,
-        &scene,
-        &quadray::geometry::CellParams::default(),
-        scene.camera.position,
-    )?;
+    let gpu = GpuScene::for_render(device, &mut cmds, &scene)?;
     let im = &scene.image;
     let variant = RenderVariant { filter: im.filter.constant(), caustics: false, volume: false, ..Default::default() };
     // Renders `spp` samples of `s` (this scene, perhaps with another seed).
@@ -904,13 +898,7 @@ fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> Result<quadr
     use quadray::shader_interface::{INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, SHADING_FULL, SHADING_NONE};
     let device = &ctx.device;
     let mut cmds = quadray::vk::Commands::new(device)?;
-    let gpu = GpuScene::with_origin(
-        device,
-        &mut cmds,
-        scene,
-        &quadray::geometry::CellParams::default(),
-        scene.camera.position,
-    )?;
+    let gpu = GpuScene::for_render(device, &mut cmds, scene)?;
     let im = &scene.image;
     let variants = [
         (

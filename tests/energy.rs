@@ -10,7 +10,6 @@ mod common;
 
 use std::path::Path;
 
-use quadray::geometry::CellParams;
 use quadray::passes::outliers::{describe_path, largest_sample, luminance, outliers, SampleBound};
 use quadray::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
 use quadray::scene::{load_scene, parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
@@ -32,7 +31,7 @@ const BRUTE_FORCE: RenderVariant = RenderVariant {
 };
 
 fn upload(ctx: &Context, cmds: &mut Commands, scene: &Scene) -> GpuScene {
-    GpuScene::with_origin(&ctx.device, cmds, scene, &CellParams::default(), scene.camera.position).unwrap()
+    GpuScene::for_render(&ctx.device, cmds, scene).unwrap()
 }
 
 /// Renders `spp` samples of `scene` at `width` x `height` with its seed.

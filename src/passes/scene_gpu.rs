@@ -241,6 +241,14 @@ impl GpuScene {
         Self::with_origin(device, cmds, scene, params, DVec3::ZERO)
     }
 
+    /// The GPU scene of a render of `scene`: default cells, centred on the
+    /// camera's render origin (`Camera::render_origin`: its position, or an
+    /// animation's first keyframe), so that every command and the viewer
+    /// upload a scene alike and render it to the same numbers.
+    pub fn for_render(device: &Arc<Device>, cmds: &mut Commands, scene: &Scene) -> Result<Self, RenderError> {
+        Self::with_origin(device, cmds, scene, &CellParams::default(), scene.camera.render_origin())
+    }
+
     /// [`Self::new`] with the GPU's world frame centred on `origin`: object
     /// transforms and light positions are made relative to it in f64 before
     /// they are rounded to f32, so that geometry near `origin` (the camera,

@@ -28,7 +28,6 @@ use winit::keyboard::{Key, NamedKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
-use crate::geometry::CellParams;
 use crate::output::{tone_map, write_outputs, ExrPrecision, OutputKind};
 use crate::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
 use crate::scene::{Preset, Scene};
@@ -203,8 +202,7 @@ impl App {
         let surface = Surface::new(&instance, display, handle)?;
         let device = Device::for_surface(instance, &surface)?;
         let mut cmds = Commands::new(&device)?;
-        let scene_gpu =
-            GpuScene::with_origin(&device, &mut cmds, &self.scene, &CellParams::default(), self.scene.camera.position)?;
+        let scene_gpu = GpuScene::for_render(&device, &mut cmds, &self.scene)?;
         log::info!("viewer on {}", device.name);
         self.gpu = Some(WindowGpu { renderer: None, swapchain: None, cmds, scene_gpu, device, surface, window });
         self.dirty = Dirty { swapchain: true, renderer: true, camera: false };
