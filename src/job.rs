@@ -66,8 +66,6 @@ pub struct JobResult {
     pub end: JobEnd,
     /// The samples per pixel the job resumed from (0 when it started afresh).
     pub resumed_from: u32,
-    /// The checkpoint key ([`render_key`] of the scene and settings).
-    pub key: u64,
 }
 
 /// A description of a render for checkpoint messages.
@@ -126,18 +124,22 @@ impl Job {
     }
 
     /// Renders `scene` (the job's scene, or another frame of it: the same
-    /// objects, another camera) as [`run`] does.
+    /// objects, another camera): continues from `resume` (the checkpoint
+    /// [`read_resume`] read for this scene), writes checkpoints every
+    /// `options.checkpoint_every`, and stops (writing a last checkpoint) when
+    /// `options.stop` is set or the time limit passes. `progress` gets
+    /// (done, total) in tile-samples of the whole render.
     pub fn render(
         &mut self,
         scene: &Scene,
         options: &JobOptions,
+        resume: Option<Checkpoint>,
         progress: &mut dyn FnMut(u64, u64),
     ) -> Result<JobResult, JobError> {
         let start = Instant::now();
         let im = &scene.image;
         let key = job_key(scene, self.variant, self.bounds);
         let description = describe(scene, &options.scene_name, self.bounds);
-        let resume = options.resume.as_deref().map(|p| Checkpoint::read_for(p, key, &description)).transpose()?;
         let (renderer, cmds) = (&mut self.renderer, &mut self.cmds);
         if !self.fresh {
             renderer.set_camera(cmds, &self.gpu, scene)?;
@@ -157,11 +159,7 @@ impl Job {
             }
             Ok(())
         };
-        let tiles_per_sample = {
-            let b = self.bounds;
-            let tile = crate::passes::render::TILE as u64;
-            (b.width() as u64).div_ceil(tile) * (b.height() as u64).div_ceil(tile)
-        };
+        let tiles_per_sample = renderer.tiles_per_sample() as u64;
         let total = tiles_per_sample * im.spp as u64;
         let mut last_checkpoint = Instant::now();
         let end = loop {
@@ -186,26 +184,19 @@ impl Job {
         };
         let mut output = renderer.output(cmds)?;
         renderer.read_caustic_statistics(&mut output);
-        Ok(JobResult { output, end, resumed_from, key })
+        Ok(JobResult { output, end, resumed_from })
     }
 }
 
-/// Renders `scene` with `variant` as a job: resumes from
-/// `options.resume`, writes checkpoints every `options.checkpoint_every`,
-/// and stops (writing a last checkpoint) when `options.stop` is set or the
-/// time limit passes. `progress` gets (done, total) in tile-samples of the
-/// whole render.
-pub fn run(
-    ctx: &vk::Context,
+/// Reads the checkpoint `options.resume` names, if any, and checks that it
+/// is one of `scene` rendered with `variant` over `options.bounds`. Called
+/// before the job's GPU work, so that a wrong checkpoint is refused at once.
+pub fn read_resume(
     scene: &Scene,
     variant: RenderVariant,
     options: &JobOptions,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<JobResult, JobError> {
-    // A wrong checkpoint is refused before any GPU work.
-    if let Some(path) = &options.resume {
-        let key = job_key(scene, variant, options.bounds);
-        Checkpoint::read_for(path, key, &describe(scene, &options.scene_name, options.bounds))?;
-    }
-    Job::new(ctx, scene, variant, options.bounds)?.render(scene, options, progress)
+) -> Result<Option<Checkpoint>, JobError> {
+    let Some(path) = &options.resume else { return Ok(None) };
+    let key = job_key(scene, variant, options.bounds);
+    Ok(Some(Checkpoint::read_for(path, key, &describe(scene, &options.scene_name, options.bounds))?))
 }

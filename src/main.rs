@@ -454,6 +454,19 @@ fn output_paths(output: &Path) -> Vec<PathBuf> {
     }
 }
 
+/// What to write to each of `paths`: a PNG at `exposure` (stops) where the
+/// extension says `png`, else an EXR (16-bit with `half`).
+fn output_files(paths: &[PathBuf], exposure: f32, half: bool) -> Vec<(PathBuf, OutputKind)> {
+    let precision = if half { ExrPrecision::Half } else { ExrPrecision::Float };
+    paths
+        .iter()
+        .map(|p| {
+            let is_png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+            (p.clone(), if is_png { OutputKind::Png { exposure } } else { OutputKind::Exr(precision) })
+        })
+        .collect()
+}
+
 /// The quality settings of `render`, `view` and `bench`: a preset, then
 /// single overrides.
 #[derive(Parser, Debug, Default, Clone)]
@@ -623,27 +636,13 @@ fn render(args: RenderArgs) -> Result<()> {
         // built once.
         let list: Vec<Option<u32>> = frames.map_or(vec![None], |f| f.into_iter().map(Some).collect());
         let first = list[0].map_or_else(|| scene.clone(), |f| scene.at_frame(f));
-        if let Some(path) = &options.resume {
-            // A wrong checkpoint is refused before any GPU work.
-            let key = quadray::job::job_key(&first, variant, bounds);
-            quadray::passes::Checkpoint::read(path).map_err(anyhow::Error::from).and_then(|c| {
-                if c.key == key {
-                    Ok(())
-                } else {
-                    Err(quadray::passes::checkpoint::CheckpointError::OtherRender {
-                        path: path.clone(),
-                        found: c.description,
-                        expected: format!("{} (another scene, setting or frame)", options.scene_name),
-                    }
-                    .into())
-                }
-            })?;
-        }
+        // A wrong checkpoint is refused before any GPU work.
+        let mut resume = quadray::job::read_resume(&first, variant, &options)?;
         let mut job = quadray::job::Job::new(&ctx, &first, variant, bounds).context("render failed")?;
         for frame in list {
             let frame_scene = frame.map_or_else(|| scene.clone(), |f| scene.at_frame(f));
             let mut progress = ProgressBar::new(args.progress);
-            let result = job.render(&frame_scene, &options, &mut |d, t| progress.update(d, t));
+            let result = job.render(&frame_scene, &options, resume.take(), &mut |d, t| progress.update(d, t));
             progress.finish();
             let result = result.context("render failed")?;
             if result.resumed_from > 0 {
@@ -686,16 +685,7 @@ fn write_render(
     if ctx.counters().errors() > 0 {
         bail!("the validation layer reported {} error(s); no output written", ctx.counters().errors());
     }
-    let precision = if args.half { ExrPrecision::Half } else { ExrPrecision::Float };
-    let files: Vec<(PathBuf, OutputKind)> = outputs
-        .iter()
-        .map(|p| {
-            let is_png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
-            let kind =
-                if is_png { OutputKind::Png { exposure: scene.image.exposure } } else { OutputKind::Exr(precision) };
-            (p.clone(), kind)
-        })
-        .collect();
+    let files = output_files(outputs, scene.image.exposure, args.half);
     let key = quadray::job::image_key(scene, variant);
     let mut metadata: Vec<(String, String)> = [
         (quadray::output::METADATA_SPP, out.spp.to_string()),
@@ -782,18 +772,7 @@ fn merge(args: MergeArgs) -> Result<()> {
         .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
         .and_then(|(_, v)| v.parse().ok())
         .unwrap_or(0.0);
-    let precision = if args.half { ExrPrecision::Half } else { ExrPrecision::Float };
-    let files: Vec<(PathBuf, OutputKind)> = output_paths(&args.output)
-        .into_iter()
-        .map(|p| {
-            let kind = if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
-                OutputKind::Png { exposure }
-            } else {
-                OutputKind::Exr(precision)
-            };
-            (p, kind)
-        })
-        .collect();
+    let files = output_files(&output_paths(&args.output), exposure, args.half);
     write_outputs_with(&out, &files, &metadata)?;
     let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
     eprintln!("merged {} tiles into {} ({}x{}, {} spp)", tiles.len(), names.join(", "), out.width, out.height, out.spp);

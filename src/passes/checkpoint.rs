@@ -56,7 +56,7 @@ pub struct Accumulation {
 impl Accumulation {
     /// The image of the work so far, `counts[i]` samples in pixel i (dropped
     /// samples black); times and pass reports are left empty.
-    pub fn output(&self, counts: &[u32]) -> RenderOutput {
+    pub fn into_output(self, counts: &[u32]) -> RenderOutput {
         let radiance = self
             .sums
             .iter()
@@ -74,7 +74,7 @@ impl Accumulation {
             bounds: self.bounds,
             frame_size: self.frame_size,
             radiance,
-            aov: self.aov.clone(),
+            aov: self.aov,
             spp: self.samples,
             partial_tiles: self.partial_tiles,
             seconds: self.render_seconds,
@@ -82,7 +82,7 @@ impl Accumulation {
             caustics: None,
             volume_seconds: None,
             dropped_samples,
-            max_sample: self.max_sample.clone(),
+            max_sample: self.max_sample,
         }
     }
 }
@@ -303,7 +303,7 @@ mod tests {
 
     #[test]
     fn output_divides_by_each_pixels_count() {
-        let out = sample().accumulation.output(&[7, 8, 7, 0]);
+        let out = sample().accumulation.into_output(&[7, 8, 7, 0]);
         assert_eq!(out.radiance[1], [1.0 / 8.0, 1.0 / 8.0, 2.0 / 8.0]);
         assert_eq!(out.radiance[3], [3.0, 1.0, 2.0]);
         // 8 samples, 7 finite: one dropped.

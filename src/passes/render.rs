@@ -21,7 +21,7 @@ use crate::vk::{
 use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
-pub const TILE: u32 = 256;
+const TILE: u32 = 256;
 
 /// What a render produces: linear radiance and AOVs, row 0 at the top, for
 /// the pixels of `bounds` (the whole frame, or a crop or tile of it).
@@ -502,6 +502,11 @@ impl Renderer {
         Ok(true)
     }
 
+    /// Dispatches (tiles) per sample.
+    pub fn tiles_per_sample(&self) -> u32 {
+        self.tiles.len() as u32
+    }
+
     /// Tiles of the next sample already added (non-zero only after
     /// [`Renderer::add_samples_until`] stopped early).
     pub fn partial_tiles(&self) -> u32 {
@@ -635,7 +640,7 @@ impl Renderer {
             caustics: self.caustics.as_ref().map(|c| CausticReport { irradiance: Vec::new(), ..c.report.clone() }),
             volume_seconds: self.volume_seconds(),
             seconds: self.seconds(),
-            ..acc.output(&self.sample_counts())
+            ..acc.into_output(&self.sample_counts())
         })
     }
 
