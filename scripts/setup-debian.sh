@@ -8,7 +8,12 @@
 #     (see .cargo/config.toml) so that shaderc is not compiled from source,
 #   - a C/C++ toolchain for linking (gcc, g++, libc6-dev) and make,
 #   - Xvfb and the X11 client libraries winit loads at run time, for the
-#     viewer (`quadray view`) and its test under a virtual display.
+#     viewer (`quadray view`) and its test under a virtual display,
+#   - Slurm (slurmctld, slurmd, slurm-client) and MUNGE for `quadray farm
+#     slurm` and its one-node-cluster test (without Recommends, which would
+#     pull in Slurm's development packages; no service is started: the test
+#     starts its own daemons). Optional: where they cannot be installed,
+#     setup warns and the farm test is skipped with the reason.
 # Idempotent: it installs only what is missing and does nothing when all is there.
 # Prints one line per step; apt's output goes to a log file that is shown
 # (its tail) only when a step fails. QUADRAY_SETUP_LOG overrides its path.
@@ -21,6 +26,8 @@ need_pkgs=(libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-t
            pkg-config gcc g++ libc6-dev make ca-certificates mesa-vulkan-drivers
            xvfb libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
 
+farm_pkgs=(slurmctld slurmd slurm-client munge)
+
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 
 mesa_has_ray_query() {
@@ -32,7 +39,9 @@ mesa_has_ray_query() {
 
 missing=()
 for p in "${need_pkgs[@]}"; do have_pkg "$p" || missing+=("$p"); done
-if [[ ${#missing[@]} -eq 0 ]] && mesa_has_ray_query; then
+farm_missing=()
+for p in "${farm_pkgs[@]}"; do have_pkg "$p" || farm_missing+=("$p"); done
+if [[ ${#missing[@]} -eq 0 && ${#farm_missing[@]} -eq 0 ]] && mesa_has_ray_query; then
   echo "setup: all system packages present"
   exit 0
 fi
@@ -68,8 +77,20 @@ if [[ $codename == bookworm ]] && ! grep -rqs "bookworm-backports" /etc/apt/sour
     < <(printf 'Types: deb\nURIs: %s\nSuites: bookworm-backports\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' "$mirror")
 fi
 
-echo "setup: missing: ${missing[*]:-none, but mesa-vulkan-drivers is older than 24.1} (apt log: $log)"
+all_missing=("${missing[@]}" "${farm_missing[@]}")
+mesa_has_ray_query || all_missing+=("mesa-vulkan-drivers >= 24.1")
+echo "setup: missing: ${all_missing[*]} (apt log: $log)"
 step "apt-get update" apt_get update
+if [[ ${#farm_missing[@]} -gt 0 ]]; then
+  echo "setup: installing ${farm_missing[*]} (for quadray farm slurm)"
+  if ! apt_get install --no-install-recommends "${farm_missing[@]}" >>"$log" 2>&1; then
+    echo "setup: WARNING: could not install ${farm_missing[*]}: the Slurm farm test will be skipped (see $log)" >&2
+  fi
+fi
+if [[ ${#missing[@]} -eq 0 ]] && mesa_has_ray_query; then
+  echo "setup: done"
+  exit 0
+fi
 if [[ $codename == bookworm ]]; then
   step "installing mesa-vulkan-drivers from bookworm-backports" \
     apt_get install -t bookworm-backports mesa-vulkan-drivers

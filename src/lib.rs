@@ -10,6 +10,7 @@
 
 pub mod bench;
 pub mod covariance;
+pub mod farm;
 pub mod filter_bench;
 pub mod geometry;
 pub mod hash;
