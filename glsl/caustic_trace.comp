@@ -27,7 +27,7 @@ layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials {
 layout(push_constant, scalar) uniform Push { Emitter emitter; } pc;
 
 // Specialisation constant: 1 when the scene has a participating medium.
-layout(constant_id = 3) const uint MEDIA_ENABLED = 0u;
+layout(constant_id = SPEC_MEDIA_ENABLED) const uint MEDIA_ENABLED = 0u;
 
 // FNV-1a step: the path identifier of a ray so far, extended by `value`.
 uint extendPath(uint path, uint value) { return (path ^ value) * 16777619u; }

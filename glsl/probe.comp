@@ -21,12 +21,12 @@ struct Hit {
     uint pad;
 };
 
-layout(set = 0, binding = BINDING_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
-layout(set = 0, binding = BINDING_HITS, scalar) writeonly buffer Hits { Hit hits[]; };
+layout(set = 0, binding = BINDING_PROBE_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
+layout(set = 0, binding = BINDING_PROBE_HITS, scalar) writeonly buffer Hits { Hit hits[]; };
 
 // Specialisation constant: 1 to write the curvatures (the geometry tests),
 // 0 to skip their Hessian (the ray benchmark times intersection alone).
-layout(constant_id = 1) const uint PROBE_CURVATURE = 1u;
+layout(constant_id = SPEC_PROBE_CURVATURE) const uint PROBE_CURVATURE = 1u;
 
 layout(push_constant, scalar) uniform Push {
     uint first;

@@ -40,24 +40,24 @@ vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index
 
 // Specialisation constant: 1 when the scene has a participating medium (the
 // fog or a dielectric's interior); 0 compiles the media code out.
-layout(constant_id = 3) const uint MEDIA_ENABLED = 0u;
+layout(constant_id = SPEC_MEDIA_ENABLED) const uint MEDIA_ENABLED = 0u;
 
 // Specialisation constant: 1 when the caustic passes ran: the primary
 // diffuse vertex reads the caustic map, and the paths it covers are left out
 // (see "caustic paths" in tracePath); 0 compiles this out.
-layout(constant_id = 4) const uint CAUSTICS_ENABLED = 0u;
+layout(constant_id = SPEC_CAUSTICS_ENABLED) const uint CAUSTICS_ENABLED = 0u;
 
 // Specialisation constant: 1 when the volume pass ran: the camera ray's
 // first segment gets its in-scattered light from it, and leaves single
 // scattering toward positional lights out of its own estimate; 0 compiles
 // this out.
-layout(constant_id = 5) const uint VOLUME_ENABLED = 0u;
+layout(constant_id = SPEC_VOLUME_ENABLED) const uint VOLUME_ENABLED = 0u;
 
 // Specialisation constant: 1 when the caustic beam pass ran (caustics in
 // fog): the camera ray's first segment gets the volumetric caustics from the
 // beam map, and a path that scatters on it and reaches a sphere light
 // through the specular vertices the caustic rays follow is left out.
-layout(constant_id = 6) const uint BEAMS_ENABLED = 0u;
+layout(constant_id = SPEC_BEAMS_ENABLED) const uint BEAMS_ENABLED = 0u;
 
 // In-scattered radiance per pixel from the volume pass (volume.comp).
 layout(set = 0, binding = BINDING_RENDER_VOLUME, scalar) readonly buffer Volume { float volume[]; };
@@ -69,10 +69,10 @@ layout(set = 0, binding = BINDING_RENDER_CAUSTICS, scalar) readonly buffer Caust
 layout(set = 0, binding = BINDING_RENDER_BEAMS, scalar) readonly buffer BeamMap { uint64_t beamMap[]; };
 
 // Specialisation constant: FILTER_NONE, FILTER_RAY_CONES or FILTER_COVARIANCE.
-layout(constant_id = 2) const uint FILTER_MODE = FILTER_NONE;
+layout(constant_id = SPEC_FILTER_MODE) const uint FILTER_MODE = FILTER_NONE;
 // Specialisation constant: LOOKUP_PROBES (trilinear probes, the default) or
 // LOOKUP_EWA (the reference lookup), for the filtered modes.
-layout(constant_id = 8) const uint LOOKUP_MODE = LOOKUP_PROBES;
+layout(constant_id = SPEC_LOOKUP_MODE) const uint LOOKUP_MODE = LOOKUP_PROBES;
 
 // A texture lookup over a footprint; FILTER_NONE ignores the footprint.
 vec4 lookup(uint index, Footprint fp) {
@@ -225,7 +225,7 @@ layout(set = 0, binding = BINDING_RENDER_MAX_SAMPLE, rg32f) uniform image2D maxS
 // Specialisation constant: 1 records every event of the path into `path`
 // (one pixel and one sample per dispatch: the outlier report's); 0 compiles
 // the recording out.
-layout(constant_id = 7) const uint RECORD_PATH = 0u;
+layout(constant_id = SPEC_RECORD_PATH) const uint RECORD_PATH = 0u;
 
 // One recorded event (host twin: GpuPathVertex in src/passes/gpu.rs).
 struct PathVertex {
@@ -268,7 +268,7 @@ void record(uint event, uint object, uint material, uint lobe, float t, float co
 // Specialisation constant: SHADING_FULL, SHADING_NONE (the first hit's
 // albedo: no light sampling, no bounces; benchmark breakdowns) or
 // SHADING_MIRRORED_ALBEDO (the albedo seen through perfect mirrors; tests).
-layout(constant_id = 1) const uint SHADING_MODE = SHADING_FULL;
+layout(constant_id = SPEC_SHADING_MODE) const uint SHADING_MODE = SHADING_FULL;
 
 // Bounces after which Russian roulette may end a path.
 const uint RR_DEPTH = 3u;

@@ -9,12 +9,12 @@
 
 layout(local_size_x = PROBE_GROUP) in;
 
-layout(set = 0, binding = 0) uniform sampler2D textures[MAX_TEXTURES];
+layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTURES];
 
 #include "texfilter.glsl"
 
 // Specialisation constant: LOOKUP_PROBES or LOOKUP_EWA.
-layout(constant_id = 0) const uint LOOKUP_MODE = LOOKUP_EWA;
+layout(constant_id = SPEC_LOOKUP_MODE) const uint LOOKUP_MODE = LOOKUP_EWA;
 
 struct TexQuery {
     uint texture;
@@ -30,8 +30,8 @@ struct TexResult {
     uint pad[3];
 };
 
-layout(set = 0, binding = 1, scalar) readonly buffer Queries { TexQuery queries[]; };
-layout(set = 0, binding = 2, scalar) writeonly buffer Results { TexResult results[]; };
+layout(set = 0, binding = BINDING_TEXPROBE_QUERIES, scalar) readonly buffer Queries { TexQuery queries[]; };
+layout(set = 0, binding = BINDING_TEXPROBE_RESULTS, scalar) writeonly buffer Results { TexResult results[]; };
 
 layout(push_constant, scalar) uniform Push {
     uint first;

@@ -6,8 +6,8 @@
 
 #include "lights.glsl"
 
-layout(set = 0, binding = 2, scalar) readonly buffer EnvTable { float envTable[]; };
-layout(set = 0, binding = 3, scalar) readonly buffer EnvTexels { vec4 envTexels[]; };
+layout(set = 0, binding = BINDING_TWIN_ENV_TABLE, scalar) readonly buffer EnvTable { float envTable[]; };
+layout(set = 0, binding = BINDING_TWIN_ENV_TEXELS, scalar) readonly buffer EnvTexels { vec4 envTexels[]; };
 layout(push_constant, scalar) uniform Push {
     uint count;
     uint envWidth;
@@ -45,8 +45,8 @@ struct TwinResult {
     float dist;        // light: distance to the light
 };
 
-layout(set = 0, binding = 0, scalar) readonly buffer Cases { TwinCase cases[]; };
-layout(set = 0, binding = 1, scalar) writeonly buffer Results { TwinResult results[]; };
+layout(set = 0, binding = BINDING_TWIN_CASES, scalar) readonly buffer Cases { TwinCase cases[]; };
+layout(set = 0, binding = BINDING_TWIN_RESULTS, scalar) writeonly buffer Results { TwinResult results[]; };
 
 float[3] f3(vec3 v) { return float[3](v.x, v.y, v.z); }
 

@@ -27,6 +27,7 @@ pub mod shader_interface;
 pub mod shaders;
 pub mod texture;
 pub mod throughput;
+#[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod vk;
 

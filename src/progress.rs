@@ -1,62 +1,102 @@
-//! A progress bar on stderr for long work (renders, benchmarks).
+//! A progress bar on stderr for long work (renders, benchmarks), drawn by
+//! `indicatif`.
 
 use std::io::{IsTerminal, Write};
-use std::time::Instant;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressDrawTarget, ProgressStyle, TermLike};
 
 /// A one-line progress bar on stderr with elapsed and estimated remaining
-/// time. It shows once the work has run for a second, and only on a terminal
-/// unless forced.
+/// time. It shows once the work has run for a second, and only on a
+/// terminal unless forced; forced onto a file or pipe, it writes a plain
+/// line a second instead of redrawing one.
 pub struct ProgressBar {
+    bar: indicatif::ProgressBar,
     start: Instant,
-    enabled: bool,
-    shown: bool,
-    label: String,
+    target: Option<ProgressDrawTarget>,
+}
+
+/// Draws on stderr as lines: for logs, where cursor movement would leave
+/// control characters.
+#[derive(Debug)]
+struct LogLines;
+
+impl TermLike for LogLines {
+    fn width(&self) -> u16 {
+        100
+    }
+    fn move_cursor_up(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn move_cursor_down(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn move_cursor_right(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn move_cursor_left(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn write_line(&self, s: &str) -> std::io::Result<()> {
+        writeln!(std::io::stderr(), "{s}")
+    }
+    fn write_str(&self, s: &str) -> std::io::Result<()> {
+        if s.trim().is_empty() {
+            return Ok(());
+        }
+        writeln!(std::io::stderr(), "{s}")
+    }
+    fn clear_line(&self) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn flush(&self) -> std::io::Result<()> {
+        std::io::stderr().flush()
+    }
 }
 
 impl ProgressBar {
     /// A bar that starts timing now; `force` shows it even when stderr is
     /// not a terminal.
     pub fn new(force: bool) -> Self {
-        Self {
-            start: Instant::now(),
-            enabled: force || std::io::stderr().is_terminal(),
-            shown: false,
-            label: String::new(),
-        }
+        let target = if std::io::stderr().is_terminal() {
+            Some(ProgressDrawTarget::stderr())
+        } else if force {
+            Some(ProgressDrawTarget::term_like_with_hz(Box::new(LogLines), 1))
+        } else {
+            None
+        };
+        let bar = indicatif::ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template("[{bar:30}] {percent:>3}%  {elapsed} elapsed, {eta} left {msg}")
+                .expect("a valid template")
+                .progress_chars("#> "),
+        );
+        Self { bar, start: Instant::now(), target }
     }
 
     /// Text shown after the bar (what is being done now).
     pub fn set_label(&mut self, label: impl Into<String>) {
-        self.label = label.into();
+        self.bar.set_message(label.into());
     }
 
-    /// Redraws the bar at `done` of `total` units.
+    /// Moves the bar to `done` of `total` units.
     pub fn update(&mut self, done: u64, total: u64) {
-        let elapsed = self.start.elapsed().as_secs_f64();
-        if !self.enabled || elapsed < 1.0 || total == 0 {
+        if total == 0 {
             return;
         }
-        let frac = (done as f64 / total as f64).clamp(0.0, 1.0);
-        let eta = if frac > 0.0 { elapsed * (1.0 - frac) / frac } else { 0.0 };
-        let width = 30;
-        let filled = (frac * width as f64) as usize;
-        eprint!(
-            "\r[{}{}] {:5.1}%  {:.1}s elapsed, {:.1}s left {}\x1b[K",
-            "#".repeat(filled),
-            " ".repeat(width - filled),
-            100.0 * frac,
-            elapsed,
-            eta,
-            self.label
-        );
-        let _ = std::io::stderr().flush();
-        self.shown = true;
+        self.bar.set_length(total);
+        self.bar.set_position(done.min(total));
+        if self.start.elapsed() >= Duration::from_secs(1) {
+            if let Some(target) = self.target.take() {
+                self.bar.set_draw_target(target);
+            }
+        }
     }
 
     /// Ends the bar's line, if it was shown.
     pub fn finish(&self) {
-        if self.shown {
-            eprintln!();
+        if !self.bar.is_hidden() {
+            self.bar.finish();
         }
     }
 }

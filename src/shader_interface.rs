@@ -23,10 +23,42 @@ pub const BINDING_FRAME: u32 = 7;
 pub const BINDING_ACCUM: u32 = 8;
 /// Descriptor binding of the AOV buffer (render pass).
 pub const BINDING_AOV: u32 = 9;
-/// Descriptor binding of the input rays (probe pass).
-pub const BINDING_RAYS: u32 = 5;
-/// Descriptor binding of the output hits (probe pass).
-pub const BINDING_HITS: u32 = 6;
+/// Descriptor binding of the input rays (probe pass; it has no materials).
+pub const BINDING_PROBE_RAYS: u32 = 5;
+/// Descriptor binding of the output hits (probe pass; it has no lights).
+pub const BINDING_PROBE_HITS: u32 = 6;
+/// Descriptor binding of the texture queries (texture probe pass).
+pub const BINDING_TEXPROBE_QUERIES: u32 = 1;
+/// Descriptor binding of the texture probe results (texture probe pass).
+pub const BINDING_TEXPROBE_RESULTS: u32 = 2;
+/// Descriptor binding of the sampling test cases (CPU-twin pass).
+pub const BINDING_TWIN_CASES: u32 = 0;
+/// Descriptor binding of the sampling test results (CPU-twin pass).
+pub const BINDING_TWIN_RESULTS: u32 = 1;
+/// Descriptor binding of the environment sampling table (CPU-twin pass).
+pub const BINDING_TWIN_ENV_TABLE: u32 = 2;
+/// Descriptor binding of the environment texels (CPU-twin pass).
+pub const BINDING_TWIN_ENV_TEXELS: u32 = 3;
+/// Specialisation constant id: intersection mode (INTERSECT_*).
+pub const SPEC_INTERSECT_MODE: u32 = 0;
+/// Specialisation constant id: shading mode (SHADING_*).
+pub const SPEC_SHADING_MODE: u32 = 1;
+/// Specialisation constant id: texture filtering mode (FILTER_*).
+pub const SPEC_FILTER_MODE: u32 = 2;
+/// Specialisation constant id: 1 when the scene has participating media.
+pub const SPEC_MEDIA_ENABLED: u32 = 3;
+/// Specialisation constant id: 1 when the caustic passes ran.
+pub const SPEC_CAUSTICS_ENABLED: u32 = 4;
+/// Specialisation constant id: 1 when the volume pass ran.
+pub const SPEC_VOLUME_ENABLED: u32 = 5;
+/// Specialisation constant id: 1 when the caustic beams ran.
+pub const SPEC_BEAMS_ENABLED: u32 = 6;
+/// Specialisation constant id: 1 to record one pixel's path.
+pub const SPEC_RECORD_PATH: u32 = 7;
+/// Specialisation constant id: texture lookup mode (LOOKUP_*).
+pub const SPEC_LOOKUP_MODE: u32 = 8;
+/// Specialisation constant id: 1 when the probe pass computes curvatures.
+pub const SPEC_PROBE_CURVATURE: u32 = 9;
 /// Descriptor binding of the texture array (render pass).
 pub const BINDING_TEXTURES: u32 = 10;
 /// Descriptor binding of the environment map's sampling tables (render pass).

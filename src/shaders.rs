@@ -53,3 +53,18 @@ pub fn volume() -> Vec<u32> {
 pub fn caustic_beams() -> Vec<u32> {
     words(include_bytes!(concat!(env!("OUT_DIR"), "/caustic_beams.comp.spv")))
 }
+
+/// Every compiled shader with its file stem, for interface checks.
+pub fn all() -> Vec<(&'static str, Vec<u32>)> {
+    vec![
+        ("render", render()),
+        ("twins", twins()),
+        ("probe", probe()),
+        ("texprobe", texprobe()),
+        ("gbuffer", gbuffer()),
+        ("caustic_trace", caustic_trace()),
+        ("caustic_splat", caustic_splat()),
+        ("caustic_beams", caustic_beams()),
+        ("volume", volume()),
+    ]
+}

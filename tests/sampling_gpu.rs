@@ -20,7 +20,7 @@ use glam::{DVec3, Vec3};
 use quadray::passes::gpu::{GpuLight, GpuMaterial};
 use quadray::sampling::{self, Bsdf};
 use quadray::scene::{ConductorFresnel, Light, Material, MaterialKind};
-use quadray::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, MemoryLocation};
+use quadray::vk::{vk, Binding, Buffer, Commands, ComputePipeline, MemoryLocation};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -56,8 +56,29 @@ struct TwinResult {
     dist: f32,
 }
 
-const _: () = assert!(std::mem::size_of::<TwinCase>() == 4 + 112 + 56 + 48);
-const _: () = assert!(std::mem::size_of::<TwinResult>() == 52);
+/// `Push` in twins.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct TwinPush {
+    count: u32,
+    env_width: u32,
+    env_height: u32,
+    env_scale: f32,
+}
+
+/// The test's structs match twins.comp member by member (names, offsets,
+/// sizes), as `tests/interface.rs` checks those of `passes::gpu`.
+#[test]
+fn twin_structs_match_the_shader() {
+    let iface = quadray::vk::reflect::ShaderInterface::reflect(&quadray::shaders::twins()).unwrap();
+    for layout in [
+        quadray::host_layout!(TwinCase as "TwinCase" { op, mat, light, wo, wi, u, x }),
+        quadray::host_layout!(TwinResult as "TwinResult" { wi, weight, pdf, valid, eval, pdf_of, dist }),
+        quadray::host_layout!(TwinPush as "Push" { count, env_width, env_height, env_scale }),
+    ] {
+        quadray::vk::reflect::check_layout(&layout, &iface.structs[layout.glsl]).unwrap();
+    }
+}
 
 fn run_twins(cases: &[TwinCase]) -> Vec<TwinResult> {
     run_twins_with(cases, None)
@@ -73,9 +94,7 @@ fn run_twins_with(cases: &[TwinCase], env: Option<TwinEnvironment<'_>>) -> Vec<T
     let counters = ctx.counters();
     let results = {
         let device = &ctx.device;
-        let pipeline =
-            ComputePipeline::new(device, &quadray::shaders::twins(), &[BindingKind::StorageBuffer; 4], 16, &[])
-                .unwrap();
+        let pipeline = ComputePipeline::new(device, &quadray::shaders::twins(), &[]).unwrap();
         let input = Buffer::with_data(device, "twin cases", cases, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
         let output = Buffer::new(
             device,
@@ -89,15 +108,18 @@ fn run_twins_with(cases: &[TwinCase], env: Option<TwinEnvironment<'_>>) -> Vec<T
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let table = Buffer::with_data(device, "environment table", table, usage).unwrap();
         let texels = Buffer::with_data(device, "environment texels", texels, usage).unwrap();
-        pipeline.bind(&[
-            Binding::Buffer(&input),
-            Binding::Buffer(&output),
-            Binding::Buffer(&table),
-            Binding::Buffer(&texels),
-        ]);
+        use quadray::shader_interface::*;
+        pipeline
+            .bind(&[
+                (BINDING_TWIN_CASES, Binding::Buffer(&input)),
+                (BINDING_TWIN_RESULTS, Binding::Buffer(&output)),
+                (BINDING_TWIN_ENV_TABLE, Binding::Buffer(&table)),
+                (BINDING_TWIN_ENV_TEXELS, Binding::Buffer(&texels)),
+            ])
+            .unwrap();
         let mut cmds = Commands::new(device).unwrap();
         let count = cases.len() as u32;
-        let push: [u32; 4] = [count, w, h, scale.to_bits()];
+        let push = TwinPush { count, env_width: w, env_height: h, env_scale: scale };
         cmds.run(|_, cmd| pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1])).unwrap();
         let mut r: Vec<TwinResult> = output.read();
         r.truncate(cases.len());

@@ -1,3 +1,4 @@
+#![cfg(feature = "viewer")]
 //! The viewer (`quadray view`) in a real X11 window under Xvfb, on lavapipe,
 //! with the Khronos validation layer on (the command fails on any error,
 //! leaks at shutdown included):

@@ -24,16 +24,16 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
-use super::gpu::{GpuCausticRay, GpuEmitter, GpuReceiver};
+use super::gpu::{CausticPush, GpuCausticRay, GpuEmitter, GpuReceiver};
 use super::scene_gpu::GpuScene;
 use crate::geometry::CellParams;
 use crate::scene::{Light, Scene};
 use crate::shader_interface::{
-    BEAM_STRIDE, CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP,
+    BEAM_STRIDE, BINDING_CAUSTIC_BEAMS, BINDING_CAUSTIC_MAP, BINDING_CAUSTIC_RAYS, BINDING_GBUFFER,
+    CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP, SPEC_INTERSECT_MODE,
+    SPEC_MEDIA_ENABLED,
 };
-use crate::vk::{
-    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation,
-};
+use crate::vk::{full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation};
 use crate::{shaders, RenderError};
 
 /// What the caustic passes did, and how long they took.
@@ -221,13 +221,6 @@ fn parallel_grid(w: DVec3, irradiance: DVec3, corners: &[DVec3], centre: DVec3, 
     grid_emitter(EMITTER_PARALLEL, centre - w * (2.0 * radius + 1.0), w, bounds, rays, irradiance)
 }
 
-/// The descriptor layout shared by the caustic shaders.
-fn binding_kinds() -> Vec<BindingKind> {
-    let mut kinds = vec![BindingKind::AccelerationStructure];
-    kinds.extend([BindingKind::StorageBuffer; 11]);
-    kinds
-}
-
 impl CausticMap {
     /// Runs the passes once for a `width` x `height` image whose frame
     /// parameters are in `frame` (`GpuFrame`), with `grids` from
@@ -289,23 +282,25 @@ impl CausticMap {
             MemoryLocation::GpuToCpu,
         )?;
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
-        let kinds = binding_kinds();
         let intersect = gpu.intersect_mode(crate::shader_interface::INTERSECT_FULL);
-        let specialisation = [intersect, 0, 0, u32::from(scene.has_media())];
-        let push = std::mem::size_of::<GpuEmitter>() as u32;
-        let gbuffer = ComputePipeline::new(device, &shaders::gbuffer(), &kinds, push, &specialisation)?;
-        let trace = ComputePipeline::new(device, &shaders::caustic_trace(), &kinds, push, &specialisation)?;
-        let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &kinds, push, &specialisation)?;
-        let beam = ComputePipeline::new(device, &shaders::caustic_beams(), &kinds, push, &specialisation)?;
+        let traced = [(SPEC_INTERSECT_MODE, intersect)];
+        let gbuffer = ComputePipeline::new(device, &shaders::gbuffer(), &traced)?;
+        let trace = ComputePipeline::new(
+            device,
+            &shaders::caustic_trace(),
+            &[(SPEC_INTERSECT_MODE, intersect), (SPEC_MEDIA_ENABLED, u32::from(scene.has_media()))],
+        )?;
+        let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &[])?;
+        let beam = ComputePipeline::new(device, &shaders::caustic_beams(), &[])?;
         let mut bindings = gpu.frame_bindings(frame);
         bindings.extend([
-            Binding::Buffer(&rays),
-            Binding::Buffer(&receivers),
-            Binding::Buffer(&map),
-            Binding::Buffer(&beams),
+            (BINDING_CAUSTIC_RAYS, Binding::Buffer(&rays)),
+            (BINDING_GBUFFER, Binding::Buffer(&receivers)),
+            (BINDING_CAUSTIC_MAP, Binding::Buffer(&map)),
+            (BINDING_CAUSTIC_BEAMS, Binding::Buffer(&beams)),
         ]);
         for p in [&gbuffer, &trace, &splat, &beam] {
-            p.bind(&bindings);
+            p.bind(&bindings)?;
         }
         let report = CausticReport { rays: ray_count, grids: grids.len(), ..Default::default() };
         Ok(Self {
@@ -335,18 +330,18 @@ impl CausticMap {
                 d.cmd_fill_buffer(cmd, beams.raw, 0, vk::WHOLE_SIZE, 0);
             }
             full_barrier(d, cmd);
-            gbuffer.dispatch(
-                cmd,
-                bytemuck::bytes_of(&GpuEmitter::default()),
-                [width.div_ceil(RENDER_GROUP), height.div_ceil(RENDER_GROUP), 1],
-            );
+            gbuffer.dispatch(cmd, &[], [width.div_ceil(RENDER_GROUP), height.div_ceil(RENDER_GROUP), 1]);
             full_barrier(d, cmd);
         })?;
         report.gbuffer_seconds = t;
 
         let ((), t) = timer.run(cmds, |d, cmd| {
             for g in grids.iter() {
-                trace.dispatch(cmd, bytemuck::bytes_of(g), [(g.grid[0] * g.grid[1]).div_ceil(CAUSTIC_GROUP), 1, 1]);
+                trace.dispatch(
+                    cmd,
+                    bytemuck::bytes_of(&CausticPush { emitter: *g }),
+                    [(g.grid[0] * g.grid[1]).div_ceil(CAUSTIC_GROUP), 1, 1],
+                );
             }
             full_barrier(d, cmd);
         })?;
@@ -355,7 +350,11 @@ impl CausticMap {
         let ((), t) = timer.run(cmds, |d, cmd| {
             for g in grids.iter() {
                 let cells = (g.grid[0] - 1) * (g.grid[1] - 1);
-                splat.dispatch(cmd, bytemuck::bytes_of(g), [cells.div_ceil(CAUSTIC_GROUP), 1, 1]);
+                splat.dispatch(
+                    cmd,
+                    bytemuck::bytes_of(&CausticPush { emitter: *g }),
+                    [cells.div_ceil(CAUSTIC_GROUP), 1, 1],
+                );
             }
             full_barrier(d, cmd);
         })?;
@@ -365,7 +364,11 @@ impl CausticMap {
             let ((), t) = timer.run(cmds, |d, cmd| {
                 for g in grids.iter() {
                     let count = ((g.grid[0] - 1) / BEAM_STRIDE) * ((g.grid[1] - 1) / BEAM_STRIDE);
-                    beam.dispatch(cmd, bytemuck::bytes_of(g), [count.div_ceil(CAUSTIC_GROUP).max(1), 1, 1]);
+                    beam.dispatch(
+                        cmd,
+                        bytemuck::bytes_of(&CausticPush { emitter: *g }),
+                        [count.div_ceil(CAUSTIC_GROUP).max(1), 1, 1],
+                    );
                 }
                 full_barrier(d, cmd);
             })?;

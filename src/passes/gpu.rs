@@ -6,11 +6,13 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DAffine3, DVec3};
 
 use crate::geometry::{Perturbation, Quadric};
+use crate::host_layout;
 use crate::scene::{ConductorFresnel, Light, Material, MaterialKind, SceneObject, UvMapping};
 use crate::shader_interface::{
     FRESNEL_COMPLEX, FRESNEL_SCHLICK, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_RECT, LIGHT_SPHERE, MATERIAL_CONDUCTOR,
     MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_MIRROR, NO_TEXTURE, UV_CYLINDRICAL, UV_PLANAR, UV_SPHERICAL,
 };
+use crate::vk::reflect::HostLayout;
 
 /// `Quadric` in interface.glsl: A's six entries, b, c.
 #[repr(C)]
@@ -531,24 +533,71 @@ pub struct GpuEmitter {
     pub power: [f32; 3],
 }
 
-const _: () = {
-    assert!(std::mem::size_of::<GpuCausticRay>() == 48);
-    assert!(std::mem::size_of::<GpuReceiver>() == 16);
-    assert!(std::mem::size_of::<GpuEmitter>() == 100);
-    assert!(std::mem::size_of::<GpuQuadric>() == 40);
-    assert!(std::mem::size_of::<GpuObject>() == 92);
-    assert!(std::mem::size_of::<GpuPerturbation>() == 60);
-    assert!(std::mem::size_of::<GpuCell>() == 32);
-    assert!(std::mem::size_of::<GpuMaterial>() == 112);
-    assert!(std::mem::size_of::<GpuMedium>() == 20);
-    assert!(std::mem::size_of::<GpuLight>() == 56);
-    assert!(std::mem::size_of::<GpuFrame>() == 124);
-    assert!(std::mem::size_of::<GpuAov>() == 32);
-    assert!(std::mem::size_of::<GpuRay>() == 32);
-    assert!(std::mem::size_of::<GpuHit>() == 32);
-    assert!(std::mem::size_of::<RenderPush>() == 24);
-    assert!(std::mem::size_of::<GpuPathVertex>() == 80);
-    assert!(std::mem::size_of::<ProbePush>() == 8);
-    assert!(std::mem::size_of::<GpuTexQuery>() == 32);
-    assert!(std::mem::size_of::<GpuTexResult>() == 32);
-};
+/// `Push` in volume.comp: one batch of the volume pass's samples.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct VolumePush {
+    /// The batch's first sample.
+    pub first_sample: u32,
+    /// Samples in the batch.
+    pub samples: u32,
+    /// Samples per pixel in all.
+    pub total: u32,
+}
+
+/// `PathRecord` in render.comp: the events of one pixel's recorded path.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct GpuPathRecord {
+    /// Events of the path (more than the vertices kept when it is long).
+    pub count: u32,
+    /// The first events.
+    pub vertices: [GpuPathVertex; crate::shader_interface::PATH_RECORD_VERTICES as usize],
+}
+
+/// `Push` in the caustic shaders: the grid being traced.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct CausticPush {
+    /// The grid.
+    pub emitter: GpuEmitter,
+}
+
+/// Every struct the host shares with the shaders, for the member-by-member
+/// check against their SPIR-V (`tests/interface.rs`): names (GLSL
+/// `camelCase` as Rust `snake_case`), order, offsets, sizes. This replaces
+/// checks by size, which a swap of two fields of one type passes.
+pub fn host_layouts() -> Vec<HostLayout> {
+    vec![
+        host_layout!(GpuQuadric as "Quadric" { a, b, c }),
+        host_layout!(GpuObject as "Object" { base, material, first_cell, uv_mapping, u_axis, v_axis, uv_scale, uv_offset }),
+        host_layout!(GpuPerturbation as "Perturbation" { q, f, centre, radius }),
+        host_layout!(GpuCell as "Cell" { lo, hi, first, count }),
+        host_layout!(GpuMaterial as "Material" {
+            kind, albedo, emission, roughness, ior, fresnel, eta, k, albedo_map, normal_map, roughness_map,
+            displacement_map, displacement_scale, normal_moments, displacement_moments, medium
+        }),
+        host_layout!(GpuMedium as "Medium" { density, albedo, anisotropy }),
+        host_layout!(GpuLight as "Light" { kind, position, radius, color, edge_u, edge_v }),
+        host_layout!(GpuFrame as "Frame" {
+            eye, forward, right, up, background, width, height, seed, light_count, max_depth, env_map, env_width,
+            env_height, env_scale, fog, pixel_sigma, footprint_fraction
+        }),
+        host_layout!(GpuAov as "Aov" { depth, normal, albedo, object }),
+        host_layout!(GpuPathVertex as "PathVertex" {
+            event, object, material, lobe, t, cos_o, cos_i, pdf, position, weight, throughput, radiance
+        }),
+        host_layout!(GpuPathRecord as "PathRecord" { count, vertices }),
+        host_layout!(GpuRay as "Ray" { origin, tmin, dir, tmax }),
+        host_layout!(GpuHit as "Hit" { t, normal, object, mean_curvature, gauss_curvature, pad }),
+        host_layout!(GpuTexQuery as "TexQuery" { texture, alpha, uv, axis1, axis2 }),
+        host_layout!(GpuTexResult as "TexResult" { value, alpha, pad }),
+        host_layout!(GpuCausticRay as "CausticRay" { position, object, flux, path, beam_start, in_fog }),
+        host_layout!(GpuReceiver as "Receiver" { position, object }),
+        host_layout!(GpuEmitter as "Emitter" { origin, kind, u, first_ray, v, max_specular, w, pad, lo, hi, grid, power }),
+        host_layout!(RenderPush as "Push" in ["render"] { tile_origin, tile_size, sample_index, write_aov }),
+        host_layout!(ProbePush as "Push" in ["probe", "texprobe"] { first, count }),
+        host_layout!(VolumePush as "Push" in ["volume"] { first_sample, samples, total }),
+        host_layout!(CausticPush as "Push" in ["caustic_trace", "caustic_splat", "caustic_beams"] { emitter }),
+    ]
+}

@@ -5,8 +5,10 @@ use std::sync::Arc;
 
 use super::gpu::{GpuHit, GpuRay, ProbePush};
 use super::scene_gpu::GpuScene;
-use crate::shader_interface::PROBE_GROUP;
-use crate::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation, Timestamps};
+use crate::shader_interface::{
+    BINDING_PROBE_HITS, BINDING_PROBE_RAYS, PROBE_GROUP, SPEC_INTERSECT_MODE, SPEC_PROBE_CURVATURE,
+};
+use crate::vk::{vk, Binding, Buffer, Commands, ComputePipeline, Device, MemoryLocation, Timestamps};
 use crate::{shaders, RenderError};
 
 /// Rays per dispatch: short enough never to trip a driver watchdog.
@@ -32,21 +34,10 @@ impl ProbePass {
         mode: u32,
         curvature: bool,
     ) -> Result<Self, RenderError> {
-        let kinds = [
-            BindingKind::AccelerationStructure,
-            BindingKind::StorageBuffer,
-            BindingKind::StorageBuffer,
-            BindingKind::StorageBuffer,
-            BindingKind::StorageBuffer,
-            BindingKind::StorageBuffer,
-            BindingKind::StorageBuffer,
-        ];
         let pipeline = ComputePipeline::new(
             device,
             &shaders::probe(),
-            &kinds,
-            std::mem::size_of::<ProbePush>() as u32,
-            &[mode, u32::from(curvature)],
+            &[(SPEC_INTERSECT_MODE, mode), (SPEC_PROBE_CURVATURE, u32::from(curvature))],
         )?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::new(
@@ -56,16 +47,10 @@ impl ProbePass {
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
-        let [tlas, objects, cells, perturbations, lists] = scene.geometry_bindings();
-        pipeline.bind(&[
-            tlas,
-            objects,
-            cells,
-            perturbations,
-            lists,
-            Binding::Buffer(&rays_buf),
-            Binding::Buffer(&hits),
-        ]);
+        let mut bindings = scene.geometry_bindings().into_iter().collect::<Vec<_>>();
+        bindings
+            .extend([(BINDING_PROBE_RAYS, Binding::Buffer(&rays_buf)), (BINDING_PROBE_HITS, Binding::Buffer(&hits))]);
+        pipeline.bind(&bindings)?;
         let timestamps = Timestamps::new(device, 2)?;
         Ok(Self { pipeline, rays: rays_buf, hits, count: rays.len() as u32, timestamps })
     }

@@ -7,16 +7,19 @@ use std::sync::Arc;
 use super::bounds::PixelBounds;
 use super::caustics::{emitters, CausticMap, CausticReport};
 use super::checkpoint::Accumulation;
-use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathVertex, RenderPush};
+use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathRecord, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::volume::VolumeLight;
 use crate::scene::Scene;
 use crate::shader_interface::{
-    FILTER_NONE, INTERSECT_FULL, LOOKUP_PROBES, MAX_TEXTURES, NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP,
-    SHADING_FULL,
+    BINDING_ACCUM, BINDING_AOV, BINDING_ENV_CDF, BINDING_RENDER_BEAMS, BINDING_RENDER_CAUSTICS, BINDING_RENDER_GBUFFER,
+    BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, BINDING_RENDER_VOLUME, FILTER_NONE, INTERSECT_FULL, LOOKUP_PROBES,
+    NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP, SHADING_FULL, SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED,
+    SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE, SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SHADING_MODE,
+    SPEC_VOLUME_ENABLED,
 };
 use crate::vk::{
-    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
+    full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
 };
 use crate::{shaders, RenderError};
 
@@ -327,7 +330,7 @@ impl Renderer {
         )?;
         // The recorded path: a count, then the vertices (std430/scalar: the
         // array starts at offset 4).
-        let path_bytes = 4 + PATH_RECORD_VERTICES as u64 * std::mem::size_of::<GpuPathVertex>() as u64;
+        let path_bytes = std::mem::size_of::<GpuPathRecord>() as u64;
         let path = Buffer::new(
             device,
             "recorded path",
@@ -343,18 +346,18 @@ impl Renderer {
             let volume_radiance = volume.as_ref().map_or(&placeholder, |v| &v.radiance);
             let mut bindings = gpu.frame_bindings(&frame);
             bindings.extend([
-                Binding::Image(&accum),
-                Binding::Buffer(&aov),
+                (BINDING_ACCUM, Binding::Image(&accum)),
+                (BINDING_AOV, Binding::Buffer(&aov)),
                 gpu.texture_binding(),
-                Binding::Buffer(&gpu.env_cdf),
-                Binding::Buffer(receivers),
-                Binding::Buffer(caustic_map),
-                Binding::Buffer(volume_radiance),
-                Binding::Buffer(beam_map),
-                Binding::Image(&max_sample),
-                Binding::Buffer(&path),
+                (BINDING_ENV_CDF, Binding::Buffer(&gpu.env_cdf)),
+                (BINDING_RENDER_GBUFFER, Binding::Buffer(receivers)),
+                (BINDING_RENDER_CAUSTICS, Binding::Buffer(caustic_map)),
+                (BINDING_RENDER_VOLUME, Binding::Buffer(volume_radiance)),
+                (BINDING_RENDER_BEAMS, Binding::Buffer(beam_map)),
+                (BINDING_RENDER_MAX_SAMPLE, Binding::Image(&max_sample)),
+                (BINDING_RENDER_PATH, Binding::Buffer(&path)),
             ]);
-            pipeline.bind(&bindings);
+            pipeline.bind(&bindings)?;
         }
         cmds.run(|_, cmd| {
             accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
@@ -667,9 +670,9 @@ impl Renderer {
         let bytes: Vec<u8> = self.path.read();
         let total = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
         let kept = total.min(PATH_RECORD_VERTICES) as usize;
-        let size = std::mem::size_of::<GpuPathVertex>();
+        let (first, size) = (std::mem::offset_of!(GpuPathRecord, vertices), std::mem::size_of::<GpuPathVertex>());
         let events =
-            (0..kept).map(|i| bytemuck::pod_read_unaligned(&bytes[4 + i * size..4 + (i + 1) * size])).collect();
+            (0..kept).map(|i| bytemuck::pod_read_unaligned(&bytes[first + i * size..first + (i + 1) * size])).collect();
         Ok(RecordedPath { events, left_out: total - kept as u32 })
     }
 }
@@ -683,35 +686,19 @@ fn render_pipeline(
     caustics: Option<&CausticMap>,
     volume: bool,
 ) -> Result<ComputePipeline, RenderError> {
-    let mut kinds = vec![BindingKind::AccelerationStructure];
-    kinds.extend([BindingKind::StorageBuffer; 7]);
-    kinds.extend([
-        BindingKind::StorageImage,
-        BindingKind::StorageBuffer,
-        BindingKind::SampledImages(MAX_TEXTURES),
-        BindingKind::StorageBuffer,
-        BindingKind::StorageBuffer,
-        BindingKind::StorageBuffer,
-        BindingKind::StorageBuffer,
-        BindingKind::StorageBuffer,
-        BindingKind::StorageImage,
-        BindingKind::StorageBuffer,
-    ]);
     Ok(ComputePipeline::new(
         device,
         &shaders::render(),
-        &kinds,
-        std::mem::size_of::<RenderPush>() as u32,
         &[
-            gpu.intersect_mode(variant.intersect),
-            variant.shading,
-            variant.filter,
-            u32::from(scene.has_media()),
-            u32::from(caustics.is_some()),
-            u32::from(volume),
-            u32::from(caustics.is_some_and(|c| c.has_beams)),
-            u32::from(variant.record_path),
-            variant.lookup,
+            (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect)),
+            (SPEC_SHADING_MODE, variant.shading),
+            (SPEC_FILTER_MODE, variant.filter),
+            (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),
+            (SPEC_CAUSTICS_ENABLED, u32::from(caustics.is_some())),
+            (SPEC_VOLUME_ENABLED, u32::from(volume)),
+            (SPEC_BEAMS_ENABLED, u32::from(caustics.is_some_and(|c| c.has_beams))),
+            (SPEC_RECORD_PATH, u32::from(variant.record_path)),
+            (SPEC_LOOKUP_MODE, variant.lookup),
         ],
     )?)
 }

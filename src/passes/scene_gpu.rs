@@ -11,7 +11,10 @@ use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
 use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Scene, TextureImage};
-use crate::shader_interface::{INTERSECT_BASE, INTERSECT_FULL, MAX_TEXTURES};
+use crate::shader_interface::{
+    BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_MATERIALS, BINDING_OBJECTS,
+    BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, INTERSECT_BASE, INTERSECT_FULL, MAX_TEXTURES,
+};
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::texture::lean;
 use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
@@ -352,10 +355,10 @@ impl GpuScene {
 
     /// The texture array: every scene texture, the rest of the slots filled
     /// with the white texture.
-    pub fn texture_binding(&self) -> Binding<'_> {
+    pub fn texture_binding(&self) -> (u32, Binding<'_>) {
         let white = self.textures.last().expect("the white texture");
         let images = (0..MAX_TEXTURES as usize).map(|i| self.textures.get(i).unwrap_or(white)).collect();
-        Binding::Textures(images, &self.sampler)
+        (BINDING_TEXTURES, Binding::Textures(images, &self.sampler))
     }
 
     /// The intersection mode to specialise shaders with: `requested`, except
@@ -374,20 +377,24 @@ impl GpuScene {
     /// The bindings `BINDING_TLAS..=BINDING_FRAME` of the passes that trace
     /// the scene for an image: geometry, materials, lights, and `frame`
     /// (`GpuFrame`).
-    pub fn frame_bindings<'a>(&'a self, frame: &'a Buffer) -> Vec<Binding<'a>> {
+    pub fn frame_bindings<'a>(&'a self, frame: &'a Buffer) -> Vec<(u32, Binding<'a>)> {
         let mut bindings = self.geometry_bindings().into_iter().collect::<Vec<_>>();
-        bindings.extend([Binding::Buffer(&self.materials), Binding::Buffer(&self.lights), Binding::Buffer(frame)]);
+        bindings.extend([
+            (BINDING_MATERIALS, Binding::Buffer(&self.materials)),
+            (BINDING_LIGHTS, Binding::Buffer(&self.lights)),
+            (BINDING_FRAME, Binding::Buffer(frame)),
+        ]);
         bindings
     }
 
     /// The bindings `BINDING_TLAS..=BINDING_CELL_LISTS` shared by all passes.
-    pub fn geometry_bindings(&self) -> [Binding<'_>; 5] {
+    pub fn geometry_bindings(&self) -> [(u32, Binding<'_>); 5] {
         [
-            Binding::AccelerationStructure(&self.tlas),
-            Binding::Buffer(&self.objects),
-            Binding::Buffer(&self.cells),
-            Binding::Buffer(&self.perturbations),
-            Binding::Buffer(&self.cell_lists),
+            (BINDING_TLAS, Binding::AccelerationStructure(&self.tlas)),
+            (BINDING_OBJECTS, Binding::Buffer(&self.objects)),
+            (BINDING_CELLS, Binding::Buffer(&self.cells)),
+            (BINDING_PERTURBATIONS, Binding::Buffer(&self.perturbations)),
+            (BINDING_CELL_LISTS, Binding::Buffer(&self.cell_lists)),
         ]
     }
 }

@@ -6,8 +6,10 @@ use std::sync::Arc;
 
 use super::gpu::{GpuTexQuery, GpuTexResult, ProbePush};
 use super::scene_gpu::GpuScene;
-use crate::shader_interface::{LOOKUP_EWA, MAX_TEXTURES, PROBE_GROUP};
-use crate::vk::{vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::shader_interface::{
+    BINDING_TEXPROBE_QUERIES, BINDING_TEXPROBE_RESULTS, LOOKUP_EWA, PROBE_GROUP, SPEC_LOOKUP_MODE,
+};
+use crate::vk::{vk, Binding, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
 use crate::{shaders, RenderError};
 
 /// Lookups per dispatch.
@@ -34,9 +36,7 @@ impl TexProbePass {
         queries: &[GpuTexQuery],
         lookup: u32,
     ) -> Result<Self, RenderError> {
-        let kinds = [BindingKind::SampledImages(MAX_TEXTURES), BindingKind::StorageBuffer, BindingKind::StorageBuffer];
-        let push_size = std::mem::size_of::<ProbePush>() as u32;
-        let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &kinds, push_size, &[lookup])?;
+        let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &[(SPEC_LOOKUP_MODE, lookup)])?;
         let query_buf = Buffer::with_data(device, "texture queries", queries, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let results = Buffer::new(
             device,
@@ -45,7 +45,11 @@ impl TexProbePass {
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
-        pipeline.bind(&[scene.texture_binding(), Binding::Buffer(&query_buf), Binding::Buffer(&results)]);
+        pipeline.bind(&[
+            scene.texture_binding(),
+            (BINDING_TEXPROBE_QUERIES, Binding::Buffer(&query_buf)),
+            (BINDING_TEXPROBE_RESULTS, Binding::Buffer(&results)),
+        ])?;
         Ok(Self { pipeline, _queries: query_buf, results, count: queries.len() as u32 })
     }
 

@@ -7,11 +7,10 @@
 
 use std::sync::Arc;
 
+use super::gpu::VolumePush;
 use super::scene_gpu::GpuScene;
-use crate::shader_interface::{INTERSECT_FULL, RENDER_GROUP};
-use crate::vk::{
-    full_barrier, vk, Binding, BindingKind, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation,
-};
+use crate::shader_interface::{BINDING_VOLUME, INTERSECT_FULL, RENDER_GROUP, SPEC_INTERSECT_MODE};
+use crate::vk::{full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation};
 use crate::{shaders, RenderError};
 
 /// Camera rays per pixel in one dispatch of the volume pass.
@@ -59,13 +58,14 @@ impl VolumeLight {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let mut kinds = vec![BindingKind::AccelerationStructure];
-        kinds.extend([BindingKind::StorageBuffer; 8]);
-        let pipeline =
-            ComputePipeline::new(device, &shaders::volume(), &kinds, 12, &[gpu.intersect_mode(INTERSECT_FULL)])?;
+        let pipeline = ComputePipeline::new(
+            device,
+            &shaders::volume(),
+            &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(INTERSECT_FULL))],
+        )?;
         let mut bindings = gpu.frame_bindings(frame);
-        bindings.push(Binding::Buffer(&radiance));
-        pipeline.bind(&bindings);
+        bindings.push((BINDING_VOLUME, Binding::Buffer(&radiance)));
+        pipeline.bind(&bindings)?;
         Ok(Self { pipeline, radiance, size: (width, height), seconds: 0.0 })
     }
 
@@ -77,7 +77,7 @@ impl VolumeLight {
         let ((), mut seconds) =
             timer.run(cmds, |d, cmd| unsafe { d.cmd_fill_buffer(cmd, radiance.raw, 0, vk::WHOLE_SIZE, 0) })?;
         for first in (0..samples).step_by(BATCH as usize) {
-            let push = [first, BATCH.min(samples - first), samples];
+            let push = VolumePush { first_sample: first, samples: BATCH.min(samples - first), total: samples };
             let ((), t) = timer.run(cmds, |d, cmd| {
                 full_barrier(d, cmd);
                 self.pipeline.dispatch(

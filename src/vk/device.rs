@@ -111,6 +111,7 @@ fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String>
 
 /// What one physical device lacks to present to `surface` from its first
 /// compute queue family (the one [`Device`] uses).
+#[cfg(feature = "viewer")]
 fn surface_shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice, surface: &super::Surface) -> Vec<String> {
     let mut missing = Vec::new();
     let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
@@ -136,17 +137,24 @@ impl Device {
     /// GPUs, then integrated, then software) and creates a logical device.
     /// When none fits, the error lists every device seen and what it lacks.
     pub fn new(instance: Arc<Instance>) -> Result<Arc<Self>, VkError> {
-        Self::select(instance, None)
+        Self::select(instance, &|_, _| Vec::new(), false)
     }
 
     /// [`Device::new`] for presenting to `surface`: the device must also
     /// support the swapchain extension and presenting to the surface from
     /// its compute queue.
+    #[cfg(feature = "viewer")]
     pub fn for_surface(instance: Arc<Instance>, surface: &super::Surface) -> Result<Arc<Self>, VkError> {
-        Self::select(instance, Some(surface))
+        Self::select(instance, &|raw, pd| surface_shortcomings(raw, pd, surface), true)
     }
 
-    fn select(instance: Arc<Instance>, surface: Option<&super::Surface>) -> Result<Arc<Self>, VkError> {
+    /// The device that fits best: ray queries and `more` lacks nothing;
+    /// `swapchain` enables VK_KHR_swapchain.
+    fn select(
+        instance: Arc<Instance>,
+        more: &dyn Fn(&ash::Instance, vk::PhysicalDevice) -> Vec<String>,
+        swapchain: bool,
+    ) -> Result<Arc<Self>, VkError> {
         let raw_instance = &instance.raw;
         let devices = unsafe { raw_instance.enumerate_physical_devices() }.map_err(|e| {
             VkError::NoSuitableDevice(format!("the Vulkan driver lists no devices ({e}).\nTo fix: {SETUP_HINT}"))
@@ -156,9 +164,7 @@ impl Device {
         for &pd in &devices {
             let props = unsafe { raw_instance.get_physical_device_properties(pd) };
             let mut missing = shortcomings(raw_instance, pd);
-            if let Some(surface) = surface {
-                missing.extend(surface_shortcomings(raw_instance, pd, surface));
-            }
+            missing.extend(more(raw_instance, pd));
             let name = device_name(&props);
             if missing.is_empty() {
                 let rank = match props.device_type {
@@ -177,7 +183,7 @@ impl Device {
             let seen = if report.is_empty() { "  (no Vulkan devices)".to_string() } else { report.join("\n") };
             return Err(VkError::NoSuitableDevice(format!("devices seen:\n{seen}\nTo fix: {SETUP_HINT}")));
         };
-        Self::create(instance.clone(), physical, surface.is_some())
+        Self::create(instance.clone(), physical, swapchain)
     }
 
     fn create(instance: Arc<Instance>, physical: vk::PhysicalDevice, swapchain: bool) -> Result<Arc<Self>, VkError> {

@@ -10,8 +10,11 @@ mod device;
 mod image;
 mod instance;
 mod pipeline;
+pub mod reflect;
 mod sampler;
+#[cfg(feature = "viewer")]
 mod surface;
+#[cfg(feature = "viewer")]
 mod swapchain;
 mod timestamps;
 
@@ -27,7 +30,9 @@ pub use image::Image;
 pub use instance::{Instance, ValidationCounters};
 pub use pipeline::{Binding, BindingKind, ComputePipeline};
 pub use sampler::Sampler;
+#[cfg(feature = "viewer")]
 pub use surface::{surface_extensions, Surface};
+#[cfg(feature = "viewer")]
 pub use swapchain::{PresentResult, Swapchain};
 pub use timestamps::{GpuTimer, Timestamps};
 
@@ -49,6 +54,9 @@ pub enum VkError {
     /// A Vulkan call failed.
     #[error("Vulkan call failed: {0}")]
     Vk(#[from] vk::Result),
+    /// The host and a shader disagree on their interface.
+    #[error("shader interface: {0}")]
+    Interface(#[from] reflect::InterfaceError),
 }
 
 /// An instance and a device, ready for work.

@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::reflect::{InterfaceError, ShaderInterface};
 use super::{AccelerationStructure, Buffer, Device, Image, Sampler, VkError};
 
 /// What a descriptor binding holds.
@@ -20,7 +21,8 @@ pub enum BindingKind {
 }
 
 impl BindingKind {
-    fn descriptor_type(self) -> vk::DescriptorType {
+    /// The Vulkan descriptor type.
+    pub fn descriptor_type(self) -> vk::DescriptorType {
         match self {
             Self::AccelerationStructure => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
             Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
@@ -29,7 +31,8 @@ impl BindingKind {
         }
     }
 
-    fn count(self) -> u32 {
+    /// Descriptors at the binding (array elements).
+    pub fn count(self) -> u32 {
         match self {
             Self::SampledImages(n) => n,
             _ => 1,
@@ -49,7 +52,20 @@ pub enum Binding<'a> {
     Textures(Vec<&'a Image>, &'a Sampler),
 }
 
-/// A compute pipeline, its layout, and one descriptor set.
+impl Binding<'_> {
+    /// The descriptor kind this resource fills.
+    pub fn kind(&self) -> BindingKind {
+        match self {
+            Self::AccelerationStructure(_) => BindingKind::AccelerationStructure,
+            Self::Buffer(_) => BindingKind::StorageBuffer,
+            Self::Image(_) => BindingKind::StorageImage,
+            Self::Textures(images, _) => BindingKind::SampledImages(images.len() as u32),
+        }
+    }
+}
+
+/// A compute pipeline, its layout, and one descriptor set, all built from
+/// the shader's reflected interface ([`ShaderInterface`]).
 pub struct ComputePipeline {
     device: Arc<Device>,
     /// The pipeline.
@@ -58,34 +74,33 @@ pub struct ComputePipeline {
     pub layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
     pool: vk::DescriptorPool,
-    /// The descriptor set (binding i holds `bindings[i]`).
+    /// The descriptor set.
     pub set: vk::DescriptorSet,
-    bindings: Vec<BindingKind>,
+    /// The shader's interface: bindings, spec constants, push constants.
+    pub interface: ShaderInterface,
 }
 
 impl ComputePipeline {
-    /// Creates the pipeline from SPIR-V words, with descriptor bindings
-    /// `0..bindings.len()` of the given kinds and `push_constant_size` bytes
-    /// of push constants.
-    pub fn new(
-        device: &Arc<Device>,
-        spirv: &[u32],
-        bindings: &[BindingKind],
-        push_constant_size: u32,
-        specialization: &[u32],
-    ) -> Result<Self, VkError> {
+    /// Creates the pipeline from SPIR-V words: its descriptor set layout and
+    /// push-constant range are those the shader declares, and
+    /// `specialization` sets constants by their ids (`SPEC_*` of
+    /// `shader_interface`); an id the shader lacks is an error.
+    pub fn new(device: &Arc<Device>, spirv: &[u32], specialization: &[(u32, u32)]) -> Result<Self, VkError> {
+        let interface = ShaderInterface::reflect(spirv)?;
+        interface.check_spec_constants(specialization.iter().map(|&(id, _)| id))?;
         let raw = &device.raw;
-        let layout_bindings: Vec<_> = bindings
+        let layout_bindings: Vec<_> = interface
+            .bindings
             .iter()
-            .enumerate()
-            .map(|(i, k)| {
+            .map(|(&i, b)| {
                 vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(k.descriptor_type())
-                    .descriptor_count(k.count())
+                    .binding(i)
+                    .descriptor_type(b.kind.descriptor_type())
+                    .descriptor_count(b.kind.count())
                     .stage_flags(vk::ShaderStageFlags::COMPUTE)
             })
             .collect();
+        let push_constant_size = interface.push_constant_size;
         let mut this = Self {
             device: device.clone(),
             raw: vk::Pipeline::null(),
@@ -93,7 +108,7 @@ impl ComputePipeline {
             set_layout: vk::DescriptorSetLayout::null(),
             pool: vk::DescriptorPool::null(),
             set: vk::DescriptorSet::null(),
-            bindings: bindings.to_vec(),
+            interface,
         };
         // From here on, `this` owns what is created and Drop cleans up on error.
         this.set_layout = unsafe {
@@ -114,10 +129,13 @@ impl ComputePipeline {
         this.layout = unsafe { raw.create_pipeline_layout(&layout_info, None) }?;
 
         let module = unsafe { raw.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(spirv), None) }?;
-        let entries: Vec<_> = (0..specialization.len())
-            .map(|i| vk::SpecializationMapEntry { constant_id: i as u32, offset: 4 * i as u32, size: 4 })
+        let entries: Vec<_> = specialization
+            .iter()
+            .enumerate()
+            .map(|(i, &(id, _))| vk::SpecializationMapEntry { constant_id: id, offset: 4 * i as u32, size: 4 })
             .collect();
-        let spec_data: &[u8] = bytemuck::cast_slice(specialization);
+        let values: Vec<u32> = specialization.iter().map(|&(_, v)| v).collect();
+        let spec_data: &[u8] = bytemuck::cast_slice(&values);
         let spec = vk::SpecializationInfo::default().map_entries(&entries).data(spec_data);
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
@@ -130,31 +148,42 @@ impl ComputePipeline {
         this.raw = created.map_err(|(_, e)| e)?[0];
 
         let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
-        for k in bindings {
-            let ty = k.descriptor_type();
+        for b in this.interface.bindings.values() {
+            let ty = b.kind.descriptor_type();
             match sizes.iter_mut().find(|s| s.ty == ty) {
-                Some(s) => s.descriptor_count += k.count(),
-                None => sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: k.count() }),
+                Some(s) => s.descriptor_count += b.kind.count(),
+                None => sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: b.kind.count() }),
             }
         }
-        this.pool = unsafe {
-            raw.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
-        }?;
-        this.set = unsafe {
-            raw.allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default().descriptor_pool(this.pool).set_layouts(&set_layouts),
-            )
-        }?[0];
+        if !sizes.is_empty() {
+            this.pool = unsafe {
+                raw.create_descriptor_pool(
+                    &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes),
+                    None,
+                )
+            }?;
+            this.set = unsafe {
+                raw.allocate_descriptor_sets(
+                    &vk::DescriptorSetAllocateInfo::default().descriptor_pool(this.pool).set_layouts(&set_layouts),
+                )
+            }?[0];
+        }
         Ok(this)
     }
 
-    /// Points every binding at its resource (`resources[i]` for binding i).
-    pub fn bind(&self, resources: &[Binding<'_>]) {
-        assert_eq!(resources.len(), self.bindings.len(), "one resource per binding");
+    /// Points the shader's bindings at resources given by binding number
+    /// (`BINDING_*` of `shader_interface`). Every binding the shader
+    /// declares needs one resource of its kind; resources at numbers the
+    /// shader does not declare are left out (passes share the scene's).
+    pub fn bind(&self, resources: &[(u32, Binding<'_>)]) -> Result<(), VkError> {
+        let kinds: Vec<(u32, BindingKind)> = resources.iter().map(|(n, r)| (*n, r.kind())).collect();
+        self.interface.check_bindings(&kinds)?;
+        let resources: Vec<&(u32, Binding<'_>)> =
+            resources.iter().filter(|(n, _)| self.interface.bindings.contains_key(n)).collect();
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
         let mut as_handles = Vec::new();
-        for r in resources {
+        for (_, r) in &resources {
             match r {
                 Binding::Buffer(b) => {
                     buffer_infos.push([vk::DescriptorBufferInfo::default().buffer(b.raw).range(vk::WHOLE_SIZE)])
@@ -181,28 +210,27 @@ impl ComputePipeline {
             .map(|h| vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(h))
             .collect();
         let mut writes = Vec::new();
-        let (mut bi, mut ii, mut ai) = (0, 0, 0);
+        let (mut bi, mut ii) = (0, 0);
         let mut as_iter = as_infos.iter_mut();
-        for (i, r) in resources.iter().enumerate() {
-            let base = vk::WriteDescriptorSet::default().dst_set(self.set).dst_binding(i as u32);
-            match (r, self.bindings[i]) {
-                (Binding::Buffer(_), BindingKind::StorageBuffer) => {
+        for (n, r) in &resources {
+            let base = vk::WriteDescriptorSet::default().dst_set(self.set).dst_binding(*n);
+            match r {
+                Binding::Buffer(_) => {
                     writes
                         .push(base.descriptor_type(vk::DescriptorType::STORAGE_BUFFER).buffer_info(&buffer_infos[bi]));
                     bi += 1;
                 }
-                (Binding::Textures(images, _), BindingKind::SampledImages(n)) => {
-                    assert_eq!(images.len(), n as usize, "binding {i}: one image per array element");
+                Binding::Textures(..) => {
                     writes.push(
                         base.descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER).image_info(&image_infos[ii]),
                     );
                     ii += 1;
                 }
-                (Binding::Image(_), BindingKind::StorageImage) => {
+                Binding::Image(_) => {
                     writes.push(base.descriptor_type(vk::DescriptorType::STORAGE_IMAGE).image_info(&image_infos[ii]));
                     ii += 1;
                 }
-                (Binding::AccelerationStructure(_), BindingKind::AccelerationStructure) => {
+                Binding::AccelerationStructure(_) => {
                     // The count must be explicit: it is not implied by a pNext chain
                     // (lavapipe silently skips the write without it).
                     let info = as_iter.next().expect("one info per acceleration structure");
@@ -211,21 +239,28 @@ impl ComputePipeline {
                             .descriptor_count(1)
                             .push_next(info),
                     );
-                    ai += 1;
                 }
-                _ => panic!("binding {i}: resource kind does not match the layout"),
             }
         }
-        debug_assert_eq!(ai, as_handles.len());
         unsafe { self.device.raw.update_descriptor_sets(&writes, &[]) };
+        Ok(())
     }
 
-    /// Records binding the pipeline and set, pushing `constants`, and a dispatch.
+    /// Records binding the pipeline and set, pushing `constants` (exactly
+    /// the shader's push-constant block), and a dispatch.
     pub fn dispatch(&self, cmd: vk::CommandBuffer, constants: &[u8], groups: [u32; 3]) {
+        assert_eq!(
+            constants.len(),
+            self.interface.push_constant_size as usize,
+            "{}",
+            InterfaceError::PushConstants { host: constants.len() as u32, shader: self.interface.push_constant_size }
+        );
         let raw = &self.device.raw;
         unsafe {
             raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw);
-            raw.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.set], &[]);
+            if self.set != vk::DescriptorSet::null() {
+                raw.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.set], &[]);
+            }
             if !constants.is_empty() {
                 raw.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, constants);
             }

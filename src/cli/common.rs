@@ -1,0 +1,148 @@
+//! Flags and helpers shared by the commands: quality and frame flags, frame
+//! ranges, output paths.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use clap::Parser;
+use quadray::output::{ExrPrecision, OutputKind};
+use quadray::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+
+/// Image size and seed overrides of `render` and `outliers`.
+#[derive(Parser, Debug, Default, Clone)]
+pub(crate) struct FrameArgs {
+    /// Image width in pixels (overrides `image.width`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub(crate) width: Option<u32>,
+    /// Image height in pixels (overrides `image.height`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub(crate) height: Option<u32>,
+    /// Random seed (overrides `image.seed`).
+    #[arg(long)]
+    pub(crate) seed: Option<u32>,
+}
+
+/// `--frames A-B[:STEP]`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FrameRange {
+    pub(crate) first: u32,
+    pub(crate) last: u32,
+    pub(crate) step: u32,
+}
+
+impl std::str::FromStr for FrameRange {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let err = || format!("{s:?}: a frame range is A-B or A-B:STEP (e.g. 1-48 or 1-48:2), A <= B, STEP >= 1");
+        let (range, step) = s.split_once(':').map_or((s, "1"), |(r, st)| (r, st));
+        let (a, b) = range.split_once('-').ok_or_else(err)?;
+        let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| err());
+        let (first, last, step) = (parse(a)?, parse(b)?, parse(step)?);
+        if first > last || step == 0 {
+            return Err(err());
+        }
+        Ok(Self { first, last, step })
+    }
+}
+
+/// Exit status of a render stopped by SIGINT or SIGTERM after it wrote its
+/// image so far (and its checkpoint): EX_TEMPFAIL of sysexits.h, "try
+/// again later".
+pub(crate) const EXIT_INTERRUPTED: i32 = 75;
+
+pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("{s:?} is not a positive number of seconds")),
+    }
+}
+
+/// Which files `-o` asks for.
+pub(crate) fn output_paths(output: &Path) -> Vec<PathBuf> {
+    match output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+        Some(e) if e == "png" || e == "exr" => vec![output.to_path_buf()],
+        _ => {
+            let mut png = output.as_os_str().to_owned();
+            png.push(".png");
+            let mut exr = output.as_os_str().to_owned();
+            exr.push(".exr");
+            vec![PathBuf::from(png), PathBuf::from(exr)]
+        }
+    }
+}
+
+/// What to write to each of `paths`: a PNG at `exposure` (stops) where the
+/// extension says `png`, else an EXR (16-bit with `half`).
+pub(crate) fn output_files(paths: &[PathBuf], exposure: f32, half: bool) -> Vec<(PathBuf, OutputKind)> {
+    let precision = if half { ExrPrecision::Half } else { ExrPrecision::Float };
+    paths
+        .iter()
+        .map(|p| {
+            let is_png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+            (p.clone(), if is_png { OutputKind::Png { exposure } } else { OutputKind::Exr(precision) })
+        })
+        .collect()
+}
+
+/// The quality settings of `render`, `view` and `bench`: a preset, then
+/// single overrides.
+#[derive(Parser, Debug, Default, Clone)]
+pub(crate) struct QualityArgs {
+    /// Quality preset: `preview`, `interactive`, `final` or `reference`
+    /// (README.md, "Quality presets"). Replaces all the scene's quality
+    /// settings (spp, max_depth, filter, caustic rays and light samples,
+    /// volume samples); the flags below override single ones.
+    #[arg(long)]
+    pub(crate) preset: Option<Preset>,
+    /// Samples per pixel (overrides the scene's or preset's `image.spp`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub(crate) spp: Option<u32>,
+    /// Longest light path in bounces (overrides `image.max_depth`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub(crate) max_depth: Option<u32>,
+    /// Texture filtering (overrides `image.filter`): `none` (bilinear lookups
+    /// of the finest mip level; with many samples per pixel, the reference),
+    /// `ray-cones` (EWA lookups over ray-cone footprints, Akenine-Möller et
+    /// al. 2021) or `covariance` (EWA lookups over covariance footprints
+    /// carried along the path).
+    #[arg(long)]
+    pub(crate) filter: Option<FilterMode>,
+    /// Caustic rays per light and light sample (overrides `caustics.rays`; 0
+    /// switches the caustic passes off).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16_777_216))]
+    pub(crate) caustic_rays: Option<u32>,
+    /// Points on each sphere light that emit caustic rays (overrides
+    /// `caustics.light_samples`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) caustic_light_samples: Option<u32>,
+    /// Camera rays per pixel and render sample of the volume pass (overrides
+    /// `volume.samples`; 0 switches the volume pass off).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=65536))]
+    pub(crate) volume_samples: Option<u32>,
+}
+
+impl QualityArgs {
+    /// Applies the preset, then the single overrides, to `scene`.
+    pub(crate) fn apply(&self, scene: &mut Scene) {
+        if let Some(p) = self.preset {
+            scene.apply_preset(p);
+        }
+        let mut q = scene.quality();
+        q.spp = self.spp.unwrap_or(q.spp);
+        q.max_depth = self.max_depth.unwrap_or(q.max_depth);
+        q.filter = self.filter.unwrap_or(q.filter);
+        q.caustic_rays = self.caustic_rays.unwrap_or(q.caustic_rays);
+        q.caustic_light_samples = self.caustic_light_samples.unwrap_or(q.caustic_light_samples);
+        q.volume_samples = self.volume_samples.unwrap_or(q.volume_samples);
+        scene.set_quality(q);
+    }
+}
+
+/// Reads `path` (or the built-in default scene when `None`).
+pub(crate) fn read_scene(path: Option<&Path>) -> Result<Scene> {
+    Ok(match path {
+        Some(path) => load_scene(path)?,
+        None => parse_scene(DEFAULT_SCENE, DEFAULT_SCENE_NAME)?,
+    })
+}

@@ -1,0 +1,96 @@
+//! `quadray merge` and `quadray compare`: commands on rendered images.
+
+use std::path::{Path, PathBuf};
+
+use super::common::*;
+use anyhow::{bail, Context as _, Result};
+use clap::Parser;
+use quadray::output::write_outputs_with;
+
+#[derive(Parser, Debug)]
+pub(crate) struct MergeArgs {
+    /// The tiles' EXR files.
+    #[arg(required = true)]
+    pub(crate) tiles: Vec<PathBuf>,
+    /// Output path, as `render -o`: `NAME.png`, `NAME.exr`, or a name
+    /// without those extensions for both.
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+    /// Write the EXR with 16-bit half floats instead of 32-bit floats.
+    #[arg(long)]
+    pub(crate) half: bool,
+}
+
+/// `quadray merge`: tiles into the whole frame.
+pub(crate) fn merge(args: MergeArgs) -> Result<()> {
+    let tiles =
+        args.tiles.iter().map(|p| Ok((p.clone(), quadray::output::read_render_exr(p)?))).collect::<Result<Vec<_>>>()?;
+    let (out, metadata) = quadray::merge::merge(&tiles)?;
+    let exposure = metadata
+        .iter()
+        .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
+        .and_then(|(_, v)| v.parse().ok())
+        .unwrap_or(0.0);
+    let files = output_files(&output_paths(&args.output), exposure, args.half);
+    write_outputs_with(&out, &files, &metadata)?;
+    let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
+    eprintln!("merged {} tiles into {} ({}x{}, {} spp)", tiles.len(), names.join(", "), out.width, out.height, out.spp);
+    Ok(())
+}
+
+#[derive(Parser, Debug)]
+pub(crate) struct CompareArgs {
+    /// The reference image (EXR).
+    pub(crate) reference: PathBuf,
+    /// The image to compare with it (EXR).
+    pub(crate) test: PathBuf,
+    /// Exposure in stops applied to both before FLIP's tone mapping.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub(crate) exposure: f32,
+}
+
+pub(crate) fn compare(args: CompareArgs) -> Result<()> {
+    let read = |path: &Path| -> Result<quadray::passes::RenderOutput> {
+        let (width, height, texels) =
+            quadray::texture::read_exr_image(path).with_context(|| format!("cannot read {}", path.display()))?;
+        Ok(quadray::passes::RenderOutput::from_radiance(
+            width,
+            height,
+            texels.iter().map(|t| [t[0], t[1], t[2]]).collect(),
+        ))
+    };
+    let reference = read(&args.reference)?;
+    let test = read(&args.test)?;
+    if (reference.width, reference.height) != (test.width, test.height) {
+        bail!(
+            "{} is {}x{} but {} is {}x{}",
+            args.reference.display(),
+            reference.width,
+            reference.height,
+            args.test.display(),
+            test.width,
+            test.height
+        );
+    }
+    let flip = quadray::metrics::flip_mean(&reference, &test, args.exposure)?;
+    let rel_mse = quadray::metrics::relative_mse(&reference, &test)?;
+    let lum = |p: &[f32; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let (worst, _) =
+        reference.radiance.iter().zip(&test.radiance).enumerate().fold((0, -1.0f32), |best, (i, (r, t))| {
+            let d = (lum(r) - lum(t)).abs();
+            if d > best.1 {
+                (i, d)
+            } else {
+                best
+            }
+        });
+    println!("FLIP {flip:.4}  relative MSE {rel_mse:.5}");
+    println!(
+        "largest luminance difference at pixel ({}, {}): reference {:.4}, test {:.4}",
+        worst as u32 % reference.width,
+        worst as u32 / reference.width,
+        lum(&reference.radiance[worst]),
+        lum(&test.radiance[worst])
+    );
+    Ok(())
+}

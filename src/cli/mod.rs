@@ -1,0 +1,10 @@
+//! The command-line commands, one module per group; `main.rs` parses and
+//! dispatches.
+
+pub(crate) mod bench;
+pub(crate) mod common;
+pub(crate) mod farm;
+pub(crate) mod images;
+pub(crate) mod render;
+#[cfg(feature = "viewer")]
+pub(crate) mod view;

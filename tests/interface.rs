@@ -1,0 +1,153 @@
+//! The host/shader interface (issue 18), checked against the compiled
+//! SPIR-V: every struct the host shares with a shader has the shader's
+//! member names, order, offsets and sizes (`passes::gpu::host_layouts`);
+//! every struct with a layout in a shader has a host twin; bindings and
+//! specialisation constants are found by number and kind. The negative
+//! cases (a swapped field, a binding of the wrong kind, a missing binding,
+//! an unknown constant id) show that the checks fail where they should.
+//! No GPU needed.
+
+use quadray::passes::gpu::host_layouts;
+use quadray::shader_interface::*;
+use quadray::vk::reflect::{check_layout, HostLayout, InterfaceError, ShaderInterface};
+use quadray::vk::BindingKind;
+
+fn interfaces() -> Vec<(&'static str, ShaderInterface)> {
+    quadray::shaders::all()
+        .into_iter()
+        .map(|(name, spirv)| (name, ShaderInterface::reflect(&spirv).unwrap_or_else(|e| panic!("{name}: {e}"))))
+        .collect()
+}
+
+fn applies(layout: &HostLayout, shader: &str) -> bool {
+    layout.shaders.is_empty() || layout.shaders.contains(&shader)
+}
+
+/// Structs of the shaders that have no twin in `passes::gpu`, and why.
+const NOT_IN_GPU_RS: [(&str, &str, &str); 3] = [
+    ("twins", "Push", "the test's push constants, checked with its Rust twin in tests/sampling_gpu.rs"),
+    ("twins", "TwinCase", "a test input, checked with its Rust twin in tests/sampling_gpu.rs"),
+    ("twins", "TwinResult", "a test output, checked with its Rust twin in tests/sampling_gpu.rs"),
+];
+
+#[test]
+fn host_structs_match_the_shaders_member_by_member() {
+    let shaders = interfaces();
+    let layouts = host_layouts();
+    for layout in &layouts {
+        let mut checked = Vec::new();
+        for (name, iface) in &shaders {
+            if let Some(s) = iface.structs.get(layout.glsl).filter(|_| applies(layout, name)) {
+                check_layout(layout, s).unwrap_or_else(|e| panic!("{name}.comp: {e}"));
+                checked.push(*name);
+            }
+        }
+        assert!(!checked.is_empty(), "no shader has a struct {} for {}", layout.glsl, layout.name);
+        eprintln!("{} = {} ({} fields) in {}", layout.name, layout.glsl, layout.fields.len(), checked.join(", "));
+    }
+    for (name, iface) in &shaders {
+        for (glsl, s) in &iface.structs {
+            // A buffer block around one runtime array is checked through
+            // the array's element (its stride is the element's size).
+            let block = s.members.len() == 1 && s.members[0].size == 0;
+            let twin = layouts.iter().any(|l| l.glsl == glsl && applies(l, name));
+            let exempt = NOT_IN_GPU_RS.iter().any(|(sh, g, _)| sh == name && g == glsl);
+            assert!(
+                block || twin || exempt,
+                "struct {glsl} of {name}.comp has no host twin in passes::gpu::host_layouts"
+            );
+        }
+    }
+}
+
+#[test]
+fn bindings_and_constants_are_declared_by_name() {
+    let shaders = interfaces();
+    let render = &shaders.iter().find(|(n, _)| *n == "render").unwrap().1;
+    let expect = [
+        (BINDING_TLAS, "tlas", BindingKind::AccelerationStructure),
+        (BINDING_OBJECTS, "Objects", BindingKind::StorageBuffer),
+        (BINDING_MATERIALS, "Materials", BindingKind::StorageBuffer),
+        (BINDING_FRAME, "frame", BindingKind::StorageBuffer),
+        (BINDING_ACCUM, "accum", BindingKind::StorageImage),
+        (BINDING_TEXTURES, "textures", BindingKind::SampledImages(MAX_TEXTURES)),
+        (BINDING_RENDER_MAX_SAMPLE, "maxSample", BindingKind::StorageImage),
+        (BINDING_RENDER_PATH, "path", BindingKind::StorageBuffer),
+    ];
+    for (binding, name, kind) in expect {
+        let b = &render.bindings[&binding];
+        assert_eq!((b.name.as_str(), b.kind), (name, kind), "render binding {binding}");
+    }
+    assert_eq!(render.bindings.len(), 18);
+    assert_eq!(render.spec_constants[&SPEC_LOOKUP_MODE], "LOOKUP_MODE");
+    assert_eq!(render.spec_constants[&SPEC_RECORD_PATH], "RECORD_PATH");
+    assert_eq!(render.push_constant_size as usize, std::mem::size_of::<quadray::passes::gpu::RenderPush>());
+    // Within a shader every binding number is one declaration, and every
+    // shader's constants use the SPEC_* ids.
+    let spec_ids = [
+        SPEC_INTERSECT_MODE,
+        SPEC_SHADING_MODE,
+        SPEC_FILTER_MODE,
+        SPEC_MEDIA_ENABLED,
+        SPEC_CAUSTICS_ENABLED,
+        SPEC_VOLUME_ENABLED,
+        SPEC_BEAMS_ENABLED,
+        SPEC_RECORD_PATH,
+        SPEC_LOOKUP_MODE,
+        SPEC_PROBE_CURVATURE,
+    ];
+    for (name, iface) in &shaders {
+        for id in iface.spec_constants.keys() {
+            assert!(spec_ids.contains(id), "{name}.comp: constant_id {id} is not a SPEC_* of shader_interface.rs");
+        }
+    }
+    let texprobe = &shaders.iter().find(|(n, _)| *n == "texprobe").unwrap().1;
+    assert_eq!(texprobe.bindings[&BINDING_TEXTURES].kind, BindingKind::SampledImages(MAX_TEXTURES));
+    assert!(texprobe.bindings.contains_key(&BINDING_TEXPROBE_QUERIES));
+}
+
+#[test]
+fn the_checks_fail_on_a_swapped_field_a_wrong_binding_and_an_unknown_constant() {
+    let shaders = interfaces();
+    let render = &shaders.iter().find(|(n, _)| *n == "render").unwrap().1;
+    // Two f32 fields of the material swapped on the host: sizes agree, the
+    // layout check does not.
+    let mut swapped = host_layouts().into_iter().find(|l| l.name == "GpuMaterial").unwrap();
+    let i = swapped.fields.iter().position(|f| f.0 == "roughness").unwrap();
+    let j = swapped.fields.iter().position(|f| f.0 == "ior").unwrap();
+    let (oi, oj) = (swapped.fields[i].1, swapped.fields[j].1);
+    swapped.fields[i].1 = oj;
+    swapped.fields[j].1 = oi;
+    swapped.fields.sort_by_key(|f| f.1);
+    let err = check_layout(&swapped, &render.structs["Material"]).unwrap_err();
+    assert!(matches!(err, InterfaceError::Layout { .. }), "{err}");
+    eprintln!("swapped fields: {err}");
+    // A field renamed on one side.
+    let mut renamed = host_layouts().into_iter().find(|l| l.name == "GpuLight").unwrap();
+    renamed.fields[2].0 = "size";
+    assert!(check_layout(&renamed, &render.structs["Light"]).is_err());
+
+    // The render pass's host bindings, then faults in them.
+    let host: Vec<(u32, BindingKind)> = render.bindings.iter().map(|(&n, b)| (n, b.kind)).collect();
+    assert_eq!(render.check_bindings(&host), Ok(vec![]));
+    let mut wrong = host.clone();
+    let accum = wrong.iter().position(|b| b.0 == BINDING_ACCUM).unwrap();
+    wrong[accum].1 = BindingKind::StorageBuffer;
+    let err = render.check_bindings(&wrong).unwrap_err();
+    assert!(matches!(err, InterfaceError::Mismatch { binding: BINDING_ACCUM, .. }), "{err}");
+    eprintln!("wrong kind: {err}");
+    let missing: Vec<_> = host.iter().copied().filter(|b| b.0 != BINDING_LIGHTS).collect();
+    let err = render.check_bindings(&missing).unwrap_err();
+    assert!(matches!(err, InterfaceError::Missing { binding: BINDING_LIGHTS, .. }), "{err}");
+    let mut twice = host.clone();
+    twice.push((BINDING_AOV, BindingKind::StorageBuffer));
+    assert_eq!(render.check_bindings(&twice), Err(InterfaceError::Twice(BINDING_AOV)));
+    // Resources at numbers the shader does not declare are left out.
+    let mut extra = host;
+    extra.push((40, BindingKind::StorageBuffer));
+    assert_eq!(render.check_bindings(&extra), Ok(vec![40]));
+
+    assert!(render.check_spec_constants([SPEC_FILTER_MODE]).is_ok());
+    let err = render.check_spec_constants([SPEC_PROBE_CURVATURE]).unwrap_err();
+    assert!(matches!(err, InterfaceError::UnknownSpecConstant { id: SPEC_PROBE_CURVATURE, .. }), "{err}");
+}
