@@ -55,7 +55,7 @@ pub enum VkError {
     #[error("Vulkan call failed: {0}")]
     Vk(#[from] vk::Result),
     /// The host and a shader disagree on their interface.
-    #[error("shader interface: {0}")]
+    #[error("the host and a shader disagree on their interface")]
     Interface(#[from] reflect::InterfaceError),
 }
 
