@@ -33,16 +33,7 @@ fn sphere_scene(n: usize) -> Scene {
         clip: None,
     };
     Scene {
-        image: ImageSettings {
-            width: 1,
-            height: 1,
-            spp: 1,
-            seed: 0,
-            exposure: 0.0,
-            max_depth: 1,
-            filter: Default::default(),
-            preset: None,
-        },
+        image: ImageSettings::minimal(1, 1),
         camera: Camera::still(DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO, DVec3::Y, 40.0),
         background: Vec3::ZERO,
         materials: vec![Material::diffuse("grey", Vec3::splat(0.8))],

@@ -16,7 +16,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 use quadray::sampling::bsdf::RoughDielectric;
-use quadray::sampling::chi2::{self, chi2_test, Chi2Config, Chi2Report, Pcg32};
+use quadray::sampling::chi2::{self, chi2_test, Chi2Config, Pcg32};
 use quadray::sampling::*;
 use quadray::scene::{Material, MaterialKind};
 
@@ -37,25 +37,12 @@ const TESTS_PER_CASE: usize = 3;
 /// Chi-square tests in this file (upper bound): 3 α × 2 ior × 5 views × 3,
 /// and 3 harness sanity tests that must pass.
 const CHI2_TESTS: usize = ALPHAS.len() * IORS.len() * VIEWS.len() * TESTS_PER_CASE + 3;
-/// Family-wise significance level.
-const FAMILY_LEVEL: f64 = 0.01;
-
-fn level() -> f64 {
-    chi2::sidak_level(FAMILY_LEVEL, CHI2_TESTS)
-}
-
-fn check(name: &str, report: &Chi2Report) {
-    report.assert_passes(name, level());
-}
-
-/// A unit direction at polar angle `theta` (from +z) and azimuth `phi`.
-fn dir(theta: f64, phi: f64) -> DVec3 {
-    DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
-}
+/// The tests of this file, judged at a family-wise level of 1 %.
+const FAMILY: chi2::Family = chi2::Family { alpha: 0.01, tests: CHI2_TESTS };
 
 /// The view direction of a [`VIEWS`] entry (azimuth 0.7).
 fn view(deg: f64, inside: bool) -> DVec3 {
-    let w = dir(deg.to_radians(), 0.7);
+    let w = spherical_direction(deg.to_radians(), 0.7);
     if inside {
         DVec3::new(w.x, w.y, -w.z)
     } else {
@@ -105,7 +92,7 @@ fn chi2_harness_sanity_on_the_full_sphere() {
         }
     };
     let r = chi2_test(&config, mixed, right);
-    check("harness: uniform up + cosine down (right pdf)", &r);
+    FAMILY.check("harness: uniform up + cosine down (right pdf)", &r);
     assert!(r.pdf_mass > 0.99 && r.valid_fraction == 1.0);
 
     // Wrong only below the horizon: uniform instead of cosine there.
@@ -125,7 +112,7 @@ fn chi2_harness_sanity_on_the_full_sphere() {
         pdf_cosine_hemisphere,
     );
     println!("{:<52} {r}", "harness: WRONG hemisphere");
-    assert!(!r.passed(level()) && r.zero_expected_hits == 400_000, "{r}");
+    assert!(!r.passed(FAMILY.level()) && r.zero_expected_hits == 400_000, "{r}");
 
     // A cap about a direction below the horizon, on a cosine lobe about −z,
     // and the uniform sphere with the default grid.
@@ -139,13 +126,13 @@ fn chi2_harness_sanity_on_the_full_sphere() {
         },
         |w| pdf_cosine_hemisphere(DVec3::new(w.x, w.y, -w.z)),
     );
-    check("harness: cosine about -z, cap about a tilted -z", &r);
+    FAMILY.check("harness: cosine about -z, cap about a tilted -z", &r);
     let r = chi2_test(
         &Chi2Config { seed: 3, ..config },
         |u| Some(sample_uniform_sphere(u[0], u[1])),
         |_| pdf_uniform_sphere(),
     );
-    check("harness: uniform sphere", &r);
+    FAMILY.check("harness: uniform sphere", &r);
 }
 
 /// The tests see the errors a rough dielectric could have: samples drawn with
@@ -172,7 +159,7 @@ fn chi2_detects_wrong_dielectrics() {
         |wi| if same_side(wo, wi) { right.pdf(wo, wi) } else { right.pdf(wo, wi) / eta2 },
     );
     println!("{:<52} {r}", "WRONG pdf (refraction Jacobian without eta²)");
-    assert!(!r.passed(level()), "{r}");
+    assert!(!r.passed(FAMILY.level()), "{r}");
 }
 
 // ---------------------------------------------------------------- chi-square
@@ -214,7 +201,7 @@ fn chi2_rough_dielectric(alpha: f64, ior: f64) {
         let name = format!("alpha = {alpha} ior = {ior} {} {deg:>2}°", if inside { "in " } else { "out" });
         let config = Chi2Config { seed, ..Chi2Config::default() };
         let r = chi2_test(&config, |u| bsdf.sample(wo, u[0], u[1], u[2]).map(|s| s.wi), |wi| bsdf.pdf(wo, wi));
-        check(&format!("{name} sphere"), &r);
+        FAMILY.check(&format!("{name} sphere"), &r);
         for reflection in [true, false] {
             let lobe = if reflection { "refl" } else { "refr" };
             let Some((axis, cap_cos)) = lobe_cap(&bsdf, wo, reflection, seed + 7) else {
@@ -228,7 +215,7 @@ fn chi2_rough_dielectric(alpha: f64, ior: f64) {
                 |u| bsdf.sample(wo, u[0], u[1], u[2]).map(|s| s.wi).filter(|&wi| same_side(wo, wi) == reflection),
                 |wi| if same_side(wo, wi) == reflection { bsdf.pdf(wo, wi) } else { 0.0 },
             );
-            check(&format!("{name} {lobe} cap {cap_cos:.4}"), &r);
+            FAMILY.check(&format!("{name} {lobe} cap {cap_cos:.4}"), &r);
         }
     }
 }

@@ -151,3 +151,16 @@ fn the_checks_fail_on_a_swapped_field_a_wrong_binding_and_an_unknown_constant() 
     let err = render.check_spec_constants([SPEC_PROBE_CURVATURE]).unwrap_err();
     assert!(matches!(err, InterfaceError::UnknownSpecConstant { id: SPEC_PROBE_CURVATURE, .. }), "{err}");
 }
+
+#[test]
+fn every_shader_in_glsl_is_compiled_and_listed() {
+    let mut files: Vec<String> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl"))
+        .unwrap()
+        .flatten()
+        .filter_map(|e| e.file_name().to_str()?.strip_suffix(".comp").map(str::to_string))
+        .collect();
+    files.sort();
+    let mut listed: Vec<String> = quadray::shaders::all().into_iter().map(|(n, _)| n.to_string()).collect();
+    listed.sort();
+    assert_eq!(files, listed);
+}

@@ -13,7 +13,7 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use quadray::sampling::chi2::{self, chi2_test, Chi2Config, Chi2Report, Pcg32};
+use quadray::sampling::chi2::{self, chi2_test, Chi2Config, Pcg32};
 use quadray::sampling::*;
 
 /// Chi-square tests run by this file (the Šidák correction divides the
@@ -21,21 +21,8 @@ use quadray::sampling::*;
 /// uniform cone 2, diffuse BSDF 1, GGX 4 α × 3 wo × (wi, m) = 24, sphere light
 /// 2, rect light 2. (The two deliberately wrong tests are not counted: they must fail.)
 const CHI2_TESTS: usize = 33;
-/// Family-wise significance level.
-const FAMILY_LEVEL: f64 = 0.01;
-
-fn level() -> f64 {
-    chi2::sidak_level(FAMILY_LEVEL, CHI2_TESTS)
-}
-
-fn check(name: &str, report: &Chi2Report) {
-    report.assert_passes(name, level());
-}
-
-/// A unit direction at polar angle `theta` (from +z) and azimuth `phi`.
-fn dir(theta: f64, phi: f64) -> DVec3 {
-    DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
-}
+/// The tests of this file, judged at a family-wise level of 1 %.
+const FAMILY: chi2::Family = chi2::Family { alpha: 0.01, tests: CHI2_TESTS };
 
 /// A random unit direction in the upper hemisphere (cos θ uniform in (0, 1]).
 fn random_upper(rng: &mut Pcg32) -> DVec3 {
@@ -52,13 +39,13 @@ fn random_upper(rng: &mut Pcg32) -> DVec3 {
 #[test]
 fn chi2_cosine_hemisphere() {
     let r = chi2_test(&Chi2Config::default(), |u| Some(sample_cosine_hemisphere(u[0], u[1])), pdf_cosine_hemisphere);
-    check("cosine hemisphere", &r);
+    FAMILY.check("cosine hemisphere", &r);
 }
 
 #[test]
 fn chi2_uniform_sphere() {
     let r = chi2_test(&Chi2Config::default(), |u| Some(sample_uniform_sphere(u[0], u[1])), |_| pdf_uniform_sphere());
-    check("uniform sphere", &r);
+    FAMILY.check("uniform sphere", &r);
 }
 
 #[test]
@@ -68,7 +55,7 @@ fn chi2_uniform_cone() {
         let config = Chi2Config { cap_cos: cos_max, seed: 11 + (cos_max * 100.0) as u64, ..Chi2Config::default() };
         let r =
             chi2_test(&config, |u| Some(sample_uniform_cone(u[0], u[1], cos_max)), |w| pdf_uniform_cone(cos_max, w));
-        check(&format!("uniform cone cos_max = {cos_max}"), &r);
+        FAMILY.check(&format!("uniform cone cos_max = {cos_max}"), &r);
     }
 }
 
@@ -81,14 +68,14 @@ fn chi2_harness_rejects_a_wrong_pdf() {
     println!("{:<44} {r}", "WRONG pdf (cosine vs uniform hemisphere)");
     assert!(r.p_value < 1e-6, "the wrong pdf was not rejected: {r}");
     assert!((r.pdf_mass - 1.0).abs() < 1e-6 && r.valid_fraction == 1.0);
-    assert!(!r.passed(level()));
+    assert!(!r.passed(FAMILY.level()));
 }
 
 /// The harness is sensitive: GGX reflections sampled with α 3% too large
 /// (0.206 instead of 0.2) are rejected (p ~ 1e-69; a 2% error is rejected too).
 #[test]
 fn chi2_harness_detects_a_small_alpha_error() {
-    let (alpha, wo) = (0.2, dir(45f64.to_radians(), 0.7));
+    let (alpha, wo) = (0.2, spherical_direction(45f64.to_radians(), 0.7));
     let wrong = Conductor { alpha: alpha * 1.03, fresnel: FresnelModel::Schlick { f0: DVec3::ONE } };
     let right = Conductor { alpha, fresnel: FresnelModel::Schlick { f0: DVec3::ONE } };
     let config = Chi2Config { axis: reflect(wo), cap_cos: 1.0 - 20.0 * alpha * alpha, ..Chi2Config::default() };
@@ -102,10 +89,10 @@ fn chi2_harness_detects_a_small_alpha_error() {
 #[test]
 fn chi2_diffuse_bsdf() {
     let bsdf = Diffuse { albedo: DVec3::new(0.8, 0.5, 0.2) };
-    let wo = dir(1.0, 2.0);
+    let wo = spherical_direction(1.0, 2.0);
     let config = Chi2Config { seed: 21, ..Chi2Config::default() };
     let r = chi2_test(&config, |u| bsdf.sample(wo, u[0], u[1], u[2]).map(|s| s.wi), |wi| bsdf.pdf(wo, wi));
-    check("diffuse BSDF", &r);
+    FAMILY.check("diffuse BSDF", &r);
 }
 
 /// View directions of the GGX tests: at the normal (exercising the
@@ -117,7 +104,7 @@ const GGX_VIEW_DEGREES: [f64; 3] = [0.0, 45.0, 85.0];
 fn chi2_ggx(alpha: f64) {
     let conductor = Conductor { alpha, fresnel: FresnelModel::Schlick { f0: DVec3::ONE } };
     for (k, deg) in GGX_VIEW_DEGREES.into_iter().enumerate() {
-        let wo = dir(deg.to_radians(), 0.7);
+        let wo = spherical_direction(deg.to_radians(), 0.7);
         let seed = (alpha * 1e4) as u64 * 10 + k as u64;
         // A cap centred on the mirror direction, sized to the lobe (~2α wide).
         let spread = 20.0 * alpha * alpha;
@@ -129,12 +116,12 @@ fn chi2_ggx(alpha: f64) {
         };
         let r =
             chi2_test(&config, |u| conductor.sample(wo, u[0], u[1], u[2]).map(|s| s.wi), |wi| conductor.pdf(wo, wi));
-        check(&format!("GGX wi  alpha = {alpha:<4} theta_o = {deg:>2}°"), &r);
+        FAMILY.check(&format!("GGX wi  alpha = {alpha:<4} theta_o = {deg:>2}°"), &r);
 
         let config =
             Chi2Config { cap_cos: (1.0 - 10.0 * alpha * alpha).max(0.0), seed: seed + 5, ..Chi2Config::default() };
         let r = chi2_test(&config, |u| Some(ggx::sample_vndf(alpha, wo, u[0], u[1])), |m| ggx::pdf_vndf(alpha, wo, m));
-        check(&format!("GGX m   alpha = {alpha:<4} theta_o = {deg:>2}°"), &r);
+        FAMILY.check(&format!("GGX m   alpha = {alpha:<4} theta_o = {deg:>2}°"), &r);
     }
 }
 
@@ -202,7 +189,7 @@ fn delta_reflections_are_exact() {
     assert!(smooth.is_delta());
     let mirror = Mirror { albedo: DVec3::new(0.9, 0.8, 0.7) };
     for (theta, phi) in [(0.0, 0.0), (0.4, 1.0), (1.5, -2.0)] {
-        let wo = dir(theta, phi);
+        let wo = spherical_direction(theta, phi);
         let s = smooth.sample(wo, 0.3, 0.6, 0.9).unwrap();
         assert_eq!(s.wi, DVec3::new(-wo.x, -wo.y, wo.z));
         assert_eq!(s.weight, fresnel_conductor(wo.z, DVec3::new(0.2, 0.92, 1.1), DVec3::new(3.9, 2.45, 2.14)));
@@ -223,7 +210,7 @@ fn dielectric_directions_are_exact() {
     let ior = 1.5;
     let glass = SmoothDielectric { ior };
     for (theta, phi) in [(0.0, 0.0), (0.3, 0.5), (0.7, 2.0), (1.2, -1.0), (2.0, 0.2), (2.9, 3.0), (PI, 0.0)] {
-        let wo = dir(theta, phi);
+        let wo = spherical_direction(theta, phi);
         let f = fresnel_dielectric(wo.z, ior);
         // u3 below F: reflection.
         if f > 0.0 {
@@ -354,7 +341,7 @@ fn ggx_ndf_projected_area_is_one() {
 fn ggx_visible_normals_are_normalised() {
     for alpha in [0.05, 0.2, 0.5, 1.0] {
         for deg in [0.0, 30.0, 60.0, 85.0, 89.0] {
-            let wo = dir(f64::to_radians(deg), 0.3);
+            let wo = spherical_direction(f64::to_radians(deg), 0.3);
             let total = chi2::integrate_sphere(&|m| ggx::pdf_vndf(alpha, wo, m), 1e-9);
             println!("alpha = {alpha:<5} theta_o = {deg:>2}°  ∫ D_wo(m) dω = {total:.9}");
             assert!((total - 1.0).abs() < 1e-3, "alpha {alpha}, theta_o {deg}: {total}");
@@ -442,7 +429,7 @@ fn chi2_sphere_light() {
             |u| sample_sphere_light(x, centre, radius, DVec3::ONE, u[0], u[1]).map(|s| s.wi),
             |wi| pdf_sphere_light(x, centre, radius, wi),
         );
-        check(&format!("sphere light cos_max = {cos_max:.4}"), &r);
+        FAMILY.check(&format!("sphere light cos_max = {cos_max:.4}"), &r);
     }
 }
 
@@ -464,7 +451,7 @@ fn chi2_rect_light() {
             |u| sample_rect_light(x, corner, eu, ev, DVec3::ONE, u[0], u[1]).map(|s| s.wi),
             |wi| pdf_rect_light(x, corner, eu, ev, wi),
         );
-        check(&format!("rect light (distance {:.2})", (x - centre).length()), &r);
+        FAMILY.check(&format!("rect light (distance {:.2})", (x - centre).length()), &r);
     }
 }
 
@@ -482,7 +469,7 @@ fn delta_and_environment_lights() {
     // A Lambertian surface under a uniform environment of radiance L
     // reflects albedo · L: Σ f L cos / pdf over environment samples.
     let (albedo, mut rng, n) = (0.6, Pcg32::new(5, 5), 400_000);
-    let wo = dir(0.5, 0.0);
+    let wo = spherical_direction(0.5, 0.0);
     let bsdf = Diffuse { albedo: DVec3::splat(albedo) };
     let mut sum = 0.0;
     for _ in 0..n {

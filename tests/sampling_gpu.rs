@@ -96,11 +96,10 @@ fn run_twins_with(cases: &[TwinCase], env: Option<TwinEnvironment<'_>>) -> Vec<T
         let device = &ctx.device;
         let pipeline = ComputePipeline::new(device, &quadray::shaders::twins(), &[]).unwrap();
         let input = Buffer::with_data(device, "twin cases", cases, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
-        let output = Buffer::new(
+        let output = Buffer::storage(
             device,
             "twin results",
             (cases.len() * std::mem::size_of::<TwinResult>()) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )
         .unwrap();

@@ -253,34 +253,20 @@ impl CausticMap {
     ) -> Result<Self, RenderError> {
         let pixels = width as u64 * height as u64;
         let ray_count: u64 = grids.iter().map(|g| g.grid[0] as u64 * g.grid[1] as u64).sum();
-        let rays = Buffer::new(
+        let rays = Buffer::storage(
             device,
             "caustic rays",
             ray_count.max(1) * std::mem::size_of::<GpuCausticRay>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
-        let receivers = Buffer::new(
+        let receivers = Buffer::storage(
             device,
             "receivers",
             pixels * std::mem::size_of::<GpuReceiver>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuOnly,
         )?;
-        let map = Buffer::new(
-            device,
-            "caustic map",
-            pixels * 24,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
-        let beams = Buffer::new(
-            device,
-            "beam map",
-            pixels * 24,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let map = Buffer::storage(device, "caustic map", pixels * 24, MemoryLocation::GpuToCpu)?;
+        let beams = Buffer::storage(device, "beam map", pixels * 24, MemoryLocation::GpuToCpu)?;
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
         let intersect = gpu.intersect_mode(crate::shader_interface::INTERSECT_FULL);
         let traced = [(SPEC_INTERSECT_MODE, intersect)];

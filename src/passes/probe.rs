@@ -40,11 +40,10 @@ impl ProbePass {
             &[(SPEC_INTERSECT_MODE, mode), (SPEC_PROBE_CURVATURE, u32::from(curvature))],
         )?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
-        let hits = Buffer::new(
+        let hits = Buffer::storage(
             device,
             "probe hits",
             (rays.len() * std::mem::size_of::<GpuHit>()) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
         let mut bindings = scene.geometry_bindings().into_iter().collect::<Vec<_>>();

@@ -297,22 +297,11 @@ impl Renderer {
             None
         };
         // Bound in place of the outputs of the passes that did not run.
-        let placeholder =
-            Buffer::new(device, "placeholder", 24, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuOnly)?;
-        let accum = Image::new(
-            device,
-            "accumulation",
-            vk::Extent2D { width, height },
-            vk::Format::R32G32B32A32_SFLOAT,
-            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
-        )?;
-        let max_sample = Image::new(
-            device,
-            "largest sample",
-            vk::Extent2D { width, height },
-            vk::Format::R32G32_SFLOAT,
-            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST,
-        )?;
+        let placeholder = Buffer::storage(device, "placeholder", 24, MemoryLocation::GpuOnly)?;
+        let accum =
+            Image::storage(device, "accumulation", vk::Extent2D { width, height }, vk::Format::R32G32B32A32_SFLOAT)?;
+        let max_sample =
+            Image::storage(device, "largest sample", vk::Extent2D { width, height }, vk::Format::R32G32_SFLOAT)?;
         // Holds the accumulation, then the largest samples (half its size).
         let readback = Buffer::new(
             device,
@@ -321,23 +310,12 @@ impl Renderer {
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let aov = Buffer::new(
-            device,
-            "aov",
-            pixels * std::mem::size_of::<GpuAov>() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let aov =
+            Buffer::storage(device, "aov", pixels * std::mem::size_of::<GpuAov>() as u64, MemoryLocation::GpuToCpu)?;
         // The recorded path: a count, then the vertices (std430/scalar: the
         // array starts at offset 4).
         let path_bytes = std::mem::size_of::<GpuPathRecord>() as u64;
-        let path = Buffer::new(
-            device,
-            "recorded path",
-            path_bytes,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let path = Buffer::storage(device, "recorded path", path_bytes, MemoryLocation::GpuToCpu)?;
         let pipeline = render_pipeline(device, gpu, scene, variant, caustics.as_ref(), volume.is_some())?;
         {
             let receivers = caustics.as_ref().map_or(&placeholder, |c| &c.receivers);

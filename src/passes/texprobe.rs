@@ -38,11 +38,10 @@ impl TexProbePass {
     ) -> Result<Self, RenderError> {
         let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &[(SPEC_LOOKUP_MODE, lookup)])?;
         let query_buf = Buffer::with_data(device, "texture queries", queries, vk::BufferUsageFlags::STORAGE_BUFFER)?;
-        let results = Buffer::new(
+        let results = Buffer::storage(
             device,
             "texture query results",
             (queries.len().max(1) * std::mem::size_of::<GpuTexResult>()) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
         pipeline.bind(&[

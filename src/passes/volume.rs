@@ -51,13 +51,8 @@ impl VolumeLight {
         frame: &Buffer,
         (width, height): (u32, u32),
     ) -> Result<Self, RenderError> {
-        let radiance = Buffer::new(
-            device,
-            "volume radiance",
-            width as u64 * height as u64 * 12,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let radiance =
+            Buffer::storage(device, "volume radiance", width as u64 * height as u64 * 12, MemoryLocation::GpuToCpu)?;
         let pipeline = ComputePipeline::new(
             device,
             &shaders::volume(),

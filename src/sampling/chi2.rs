@@ -178,6 +178,29 @@ impl fmt::Display for Chi2Report {
     }
 }
 
+/// A family of chi-square tests judged together: each passes at the Šidák
+/// level ([`sidak_level`]) that keeps the family-wise chance of a false
+/// alarm at `alpha`.
+#[derive(Clone, Copy, Debug)]
+pub struct Family {
+    /// Family-wise significance level.
+    pub alpha: f64,
+    /// Tests in the family.
+    pub tests: usize,
+}
+
+impl Family {
+    /// The level each test of the family is judged at.
+    pub fn level(&self) -> f64 {
+        sidak_level(self.alpha, self.tests)
+    }
+
+    /// Prints `report` and asserts that it passes at [`Family::level`].
+    pub fn check(&self, name: &str, report: &Chi2Report) {
+        report.assert_passes(name, self.level());
+    }
+}
+
 /// Per-test significance level giving a family-wise level `alpha` over `tests`
 /// independent tests (Šidák): 1 − (1 − alpha)^(1/tests) (≈ alpha / tests).
 pub fn sidak_level(alpha: f64, tests: usize) -> f64 {

@@ -43,5 +43,5 @@ pub use lights::{
 };
 pub use warp::{
     frame_around, pdf_cosine_hemisphere, pdf_uniform_cone, pdf_uniform_sphere, sample_cosine_hemisphere,
-    sample_uniform_cone, sample_uniform_sphere,
+    sample_uniform_cone, sample_uniform_sphere, spherical_direction,
 };

@@ -68,6 +68,11 @@ pub(crate) fn uniform_cone_pdf(one_minus_cos_max: f64) -> f64 {
     1.0 / (2.0 * PI * one_minus_cos_max)
 }
 
+/// The unit direction at polar angle `theta` from +z and azimuth `phi`.
+pub fn spherical_direction(theta: f64, phi: f64) -> DVec3 {
+    DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+}
+
 /// Two unit tangents (tu, tv) completing the unit `w` to a right-handed
 /// orthonormal frame (tu × tv = w), as the renderer builds it:
 /// a = |w.x| > 0.9 ? (0, 1, 0) : (1, 0, 0); tu = normalize(a × w); tv = w × tu.

@@ -110,6 +110,25 @@ pub struct ImageSettings {
     pub preset: Option<Preset>,
 }
 
+impl ImageSettings {
+    /// `width` x `height`, one sample per pixel, seed 0, exposure 0,
+    /// direct lighting only (`max_depth` 1), no filtering, no preset: the
+    /// settings of scenes built in code (tests, benchmarks), which change
+    /// what they need.
+    pub fn minimal(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            spp: 1,
+            seed: 0,
+            exposure: 0.0,
+            max_depth: 1,
+            filter: FilterMode::default(),
+            preset: None,
+        }
+    }
+}
+
 /// How a surface scatters light.
 #[derive(Clone, Debug, PartialEq)]
 pub enum MaterialKind {

@@ -81,13 +81,7 @@ impl AccelerationStructure {
         };
 
         let align = device.accel_properties.min_scratch_offset_alignment.max(1) as u64;
-        let scratch = Buffer::new(
-            device,
-            "scratch",
-            sizes.build_scratch_size + align,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuOnly,
-        )?;
+        let scratch = Buffer::storage(device, "scratch", sizes.build_scratch_size + align, MemoryLocation::GpuOnly)?;
         let scratch_address = align_up(scratch.device_address(), align);
         build_info = build_info
             .dst_acceleration_structure(raw)

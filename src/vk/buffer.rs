@@ -19,6 +19,13 @@ pub struct Buffer {
 }
 
 impl Buffer {
+    /// A storage buffer of `size` bytes in `location`, which transfers can
+    /// also fill (`cmd_fill_buffer`).
+    pub fn storage(device: &Arc<Device>, name: &str, size: u64, location: MemoryLocation) -> Result<Self, VkError> {
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        Self::new(device, name, size, usage, location)
+    }
+
     /// Creates a buffer of `size` bytes (at least 4) in `location`.
     pub fn new(
         device: &Arc<Device>,

@@ -45,6 +45,19 @@ fn image_info(
 }
 
 impl Image {
+    /// A device-local storage image of `format` that transfers can fill and
+    /// read back, in layout UNDEFINED.
+    pub fn storage(
+        device: &Arc<Device>,
+        name: &str,
+        extent: vk::Extent2D,
+        format: vk::Format,
+    ) -> Result<Self, VkError> {
+        let usage =
+            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        Self::new(device, name, extent, format, usage)
+    }
+
     /// Creates a device-local image of `format` and `usage`, in layout UNDEFINED.
     pub fn new(
         device: &Arc<Device>,

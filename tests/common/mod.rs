@@ -115,16 +115,7 @@ pub fn placement(scale: DVec3, degrees: DVec3, translate: DVec3) -> DAffine3 {
 /// A scene around `objects` with one grey material and one point light.
 pub fn scene_with(objects: Vec<SceneObject>) -> Scene {
     Scene {
-        image: ImageSettings {
-            width: 64,
-            height: 48,
-            spp: 1,
-            seed: 0,
-            exposure: 0.0,
-            max_depth: 1,
-            filter: Default::default(),
-            preset: None,
-        },
+        image: ImageSettings::minimal(64, 48),
         camera: Camera::still(DVec3::new(0.0, 2.0, 8.0), DVec3::ZERO, DVec3::Y, 40.0),
         background: Vec3::ZERO,
         materials: vec![Material::diffuse("grey", Vec3::splat(0.8))],
