@@ -16,9 +16,10 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{scatter::spread_bumps, CellParams, FunctionalObject, Quadric};
 use quadray::passes::gpu::GpuRay;
+use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
 use quadray::scene::{Camera, ImageSettings, Material, Scene, SceneObject};
-use quadray::shader_interface::{INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, NO_HIT};
+use quadray::shader_interface::NO_HIT;
 use quadray::vk::{Commands, Context};
 
 const COUNTS: [usize; 4] = [0, 10, 100, 1000];
@@ -104,7 +105,7 @@ fn main() {
     // then timed once per round, round after round: the machine's speed
     // drifts by 10 - 30 % over minutes, and interleaving makes every
     // configuration see the same drift, so that the ratios hold.
-    let modes = [INTERSECT_FULL, INTERSECT_BOXES, INTERSECT_BASE];
+    let modes = [IntersectMode::Full, IntersectMode::Boxes, IntersectMode::Base];
     let gpus: Vec<GpuScene> =
         COUNTS.iter().map(|&n| GpuScene::new(&device, &mut cmds, &sphere_scene(n), &params).unwrap()).collect();
     let probes: Vec<Vec<ProbePass>> = gpus

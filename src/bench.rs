@@ -171,7 +171,7 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
         let gpu = GpuScene::for_render(device, &mut cmds, &s.scene).map_err(|e| render_error(&s.name, e))?;
         let mut measure = |scene: &Scene, label: &str, bar: &mut ProgressBar, done: &mut u64| {
             bar.set_label(format!("{}: {label}", s.name));
-            let variant = RenderVariant { filter: scene.image.filter.constant(), ..Default::default() };
+            let variant = RenderVariant::default();
             let im = &scene.image;
             // Untimed warm-up: compiles every pipeline this quality uses.
             render(device, &mut cmds, &gpu, scene, (8, 8, 1), variant, &mut |_, _| {})

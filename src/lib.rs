@@ -77,8 +77,9 @@ pub fn render_scene(
     render_scene_with(ctx, scene, Default::default(), progress)
 }
 
-/// [`render_scene`] with a variant of the render shader (texture filtering,
-/// benchmark breakdowns).
+/// [`render_scene`] with a variant of the render shader (benchmark
+/// breakdowns, brute force, path recording); everything else, the texture
+/// filtering included, comes from the scene.
 pub fn render_scene_with(
     ctx: &vk::Context,
     scene: &scene::Scene,

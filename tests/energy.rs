@@ -12,6 +12,7 @@ use std::path::Path;
 
 use quadray::passes::outliers::{describe_path, largest_sample, luminance, outliers, SampleBound};
 use quadray::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
+use quadray::passes::{IntersectMode, LookupMode, ShadingMode};
 use quadray::scene::{load_scene, parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 use quadray::vk::{Commands, Context};
 
@@ -21,13 +22,12 @@ fn stress_scene() -> Scene {
 
 /// The path tracer alone: the bound speaks of its samples.
 const BRUTE_FORCE: RenderVariant = RenderVariant {
-    intersect: quadray::shader_interface::INTERSECT_FULL,
-    shading: quadray::shader_interface::SHADING_FULL,
-    filter: quadray::shader_interface::FILTER_NONE,
+    intersect: IntersectMode::Full,
+    shading: ShadingMode::Full,
     caustics: false,
     volume: false,
     record_path: false,
-    lookup: quadray::shader_interface::LOOKUP_PROBES,
+    lookup: LookupMode::Probes,
 };
 
 fn upload(ctx: &Context, cmds: &mut Commands, scene: &Scene) -> GpuScene {

@@ -14,11 +14,8 @@ mod common;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};
-use quadray::passes::RenderVariant;
-use quadray::scene::{Material, MaterialMaps, UvMapping, UvSettings};
-use quadray::shader_interface::{
-    FILTER_COVARIANCE, FILTER_NONE, FILTER_RAY_CONES, SHADING_GLOSSY_ALBEDO, SHADING_MIRRORED_ALBEDO, SHADING_NONE,
-};
+use quadray::passes::{RenderVariant, ShadingMode};
+use quadray::scene::{FilterMode, ImageSettings, Material, MaterialMaps, Scene, UvMapping, UvSettings};
 
 const A: f32 = 0.9;
 const B: f32 = 0.1;
@@ -53,15 +50,17 @@ fn ewa_over_ray_cones_averages_a_fine_checkerboard() {
     let ctx = common::context();
     let counters = ctx.counters();
     let render = |filter| {
-        let variant = RenderVariant { filter, ..Default::default() };
-        common::finite(quadray::render_scene_with(&ctx, &scene, variant, &mut |_, _| {}).unwrap())
+        let s = Scene { image: ImageSettings { filter, ..scene.image.clone() }, ..scene.clone() };
+        common::finite(quadray::render_scene(&ctx, &s, &mut |_, _| {}).unwrap())
     };
-    let (filtered, unfiltered) = (render(FILTER_RAY_CONES), render(FILTER_NONE));
+    let (filtered, unfiltered) = (render(FilterMode::RayCones), render(FilterMode::None));
     // The covariance mode's footprint at the first hit, through the radiance
     // of the albedo-only shading variant.
     let covariance = {
-        let variant = RenderVariant { filter: FILTER_COVARIANCE, shading: SHADING_NONE, ..Default::default() };
-        common::finite(quadray::render_scene_with(&ctx, &scene, variant, &mut |_, _| {}).unwrap())
+        let s =
+            Scene { image: ImageSettings { filter: FilterMode::Covariance, ..scene.image.clone() }, ..scene.clone() };
+        let variant = RenderVariant { shading: ShadingMode::Albedo, ..Default::default() };
+        common::finite(quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap())
     };
     drop(ctx);
     common::assert_no_validation_errors(&counters);
@@ -121,18 +120,18 @@ fn filtering_adds_no_bias_without_textures() {
 
     let ctx = common::context();
     let counters = ctx.counters();
-    let render = |filter: u32, seed: u32| {
+    let render = |filter: FilterMode, seed: u32| {
         let mut s = scene.clone();
         s.image.seed = seed;
-        let variant = RenderVariant { filter, ..Default::default() };
-        let out = common::finite(quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap());
+        s.image.filter = filter;
+        let out = common::finite(quadray::render_scene(&ctx, &s, &mut |_, _| {}).unwrap());
         assert!(out.radiance.iter().flatten().all(|v| v.is_finite()), "non-finite pixel (filter {filter})");
         out
     };
-    let base = render(FILTER_NONE, 1);
-    let none = render(FILTER_NONE, 2);
-    let cones = render(FILTER_RAY_CONES, 3);
-    let cov = render(FILTER_COVARIANCE, 4);
+    let base = render(FilterMode::None, 1);
+    let none = render(FilterMode::None, 2);
+    let cones = render(FilterMode::RayCones, 3);
+    let cov = render(FilterMode::Covariance, 4);
     drop(ctx);
     common::assert_no_validation_errors(&counters);
 
@@ -165,7 +164,7 @@ const MIRROR_REFERENCE_SPP: u32 = 1024;
 /// A checker floor seen in a convex mirror ball: through the
 /// curved mirror each pixel covers a wide patch of the floor (the curvature
 /// term multiplies the footprint), which 1-spp unfiltered lookups alias and
-/// filtered ones must average. Shading variant SHADING_MIRRORED_ALBEDO (the
+/// filtered ones must average. Shading variant ShadingMode::MirroredAlbedo (the
 /// albedo seen through mirrors, no lighting), so that the reference with
 /// many samples is the exact pixel average. Compared over the pixels whose
 /// four corners all see the ball. With `QUADRAY_TEST_IMAGES=DIR` the
@@ -211,14 +210,15 @@ fn footprints_through_a_curved_mirror_average_the_reflected_checker() {
     let render = |filter, spp| {
         let mut s = scene.clone();
         s.image.spp = spp;
-        let variant = RenderVariant { filter, shading: SHADING_MIRRORED_ALBEDO, ..Default::default() };
+        s.image.filter = filter;
+        let variant = RenderVariant { shading: ShadingMode::MirroredAlbedo, ..Default::default() };
         common::finite(quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap())
     };
-    let reference = render(FILTER_NONE, MIRROR_REFERENCE_SPP);
+    let reference = render(FilterMode::None, MIRROR_REFERENCE_SPP);
     let modes = [
-        ("none", render(FILTER_NONE, 1)),
-        ("ray-cones", render(FILTER_RAY_CONES, 1)),
-        ("covariance", render(FILTER_COVARIANCE, 1)),
+        ("none", render(FilterMode::None, 1)),
+        ("ray-cones", render(FilterMode::RayCones, 1)),
+        ("covariance", render(FilterMode::Covariance, 1)),
     ];
     drop(ctx);
     common::assert_no_validation_errors(&counters);
@@ -278,7 +278,7 @@ const GLOSSY_Z: f64 = 5.0;
 const GLOSSY_FALL: f64 = 0.5;
 
 /// The prefiltering bias is gone: albedo-only (the albedo seen directly and
-/// through a glossy reflector, `SHADING_GLOSSY_ALBEDO`) on a fine checker
+/// through a glossy reflector, `ShadingMode::GlossyAlbedo`) on a fine checker
 /// wall and a glossy floor (scenes/tests/glossy_reflector.toml). For each
 /// filtered mode, the mean of `GLOSSY_SEEDS` independent 16-spp renders
 /// equals the unfiltered 4096-spp reference within their noise: the sum over
@@ -294,16 +294,19 @@ fn filtered_albedo_through_a_glossy_reflector_converges_to_the_reference() {
     let scene = quadray::scene::load_scene(&path).unwrap();
     let ctx = common::context();
     let counters = ctx.counters();
-    let render = |filter: u32, spp: u32, seed: u32| -> Vec<f64> {
+    let render = |filter: FilterMode, spp: u32, seed: u32| -> Vec<f64> {
         let mut s = scene.clone();
         s.image.spp = spp;
         s.image.seed = seed;
-        let variant = RenderVariant { filter, shading: SHADING_GLOSSY_ALBEDO, ..Default::default() };
+        s.image.filter = filter;
+        let variant = RenderVariant { shading: ShadingMode::GlossyAlbedo, ..Default::default() };
         let out = common::finite(quadray::render_scene_with(&ctx, &s, variant, &mut |_, _| {}).unwrap());
         out.radiance.iter().flatten().map(|&v| f64::from(v)).collect()
     };
-    let (a, b) =
-        (render(FILTER_NONE, GLOSSY_REFERENCE_HALF_SPP, 1001), render(FILTER_NONE, GLOSSY_REFERENCE_HALF_SPP, 1002));
+    let (a, b) = (
+        render(FilterMode::None, GLOSSY_REFERENCE_HALF_SPP, 1001),
+        render(FilterMode::None, GLOSSY_REFERENCE_HALF_SPP, 1002),
+    );
     let reference: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.5 * (x + y)).collect();
     let reference_variance: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.25 * (x - y).powi(2)).collect();
     let relative_error = |img: &[f64]| -> f64 {
@@ -316,7 +319,7 @@ fn filtered_albedo_through_a_glossy_reflector_converges_to_the_reference() {
         sum / img.len() as f64
     };
     let mut results = Vec::new();
-    for (name, filter) in [("ray-cones", FILTER_RAY_CONES), ("covariance", FILTER_COVARIANCE)] {
+    for (name, filter) in [("ray-cones", FilterMode::RayCones), ("covariance", FilterMode::Covariance)] {
         let renders: Vec<Vec<f64>> = (0..GLOSSY_SEEDS).map(|k| render(filter, 16, 10 + k)).collect();
         let k = f64::from(GLOSSY_SEEDS);
         let (mut d2, mut expected, mut expected_sq) = (0.0, 0.0, 0.0);

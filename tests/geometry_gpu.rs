@@ -18,9 +18,10 @@ mod common;
 use glam::{DAffine3, DVec3};
 use quadray::geometry::{reference, Aabb, CellParams};
 use quadray::passes::gpu::{GpuHit, GpuRay};
+use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
 use quadray::scene::SceneObject;
-use quadray::shader_interface::{INTERSECT_FULL, NO_HIT};
+use quadray::shader_interface::NO_HIT;
 use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -307,7 +308,7 @@ fn gpu_hits_match_the_f64_reference() {
         ("on-surface", &on_surface, ON_SURFACE_MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES, MAX_CURVATURE_ERROR),
         ("grazing", &grazing, MAX_DEPTH_ERROR, MAX_NORMAL_DEGREES, MAX_CURVATURE_ERROR),
     ] {
-        let probe = ProbePass::new(&ctx.device, &gpu_scene, rays, INTERSECT_FULL, true).unwrap();
+        let probe = ProbePass::new(&ctx.device, &gpu_scene, rays, IntersectMode::Full, true).unwrap();
         let (hits, _) = probe.run(&mut cmds).unwrap();
         let refs: Vec<Option<RefHit>> = rays
             .iter()

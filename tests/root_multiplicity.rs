@@ -23,8 +23,9 @@ mod common;
 use glam::{DAffine3, DVec3};
 use quadray::geometry::{Aabb, CellParams, FunctionalObject, Perturbation, Quadric};
 use quadray::passes::gpu::GpuRay;
+use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
-use quadray::shader_interface::{INTERSECT_FULL, NO_HIT};
+use quadray::shader_interface::NO_HIT;
 use quadray::vk::Commands;
 
 const F32_EPSILON: f64 = 1.0 / 8_388_608.0;
@@ -44,7 +45,8 @@ fn trace(shape: FunctionalObject, probes: &[Probe]) -> Vec<quadray::passes::gpu:
     let scene = common::scene_with(vec![common::object("shape", shape, DAffine3::IDENTITY)]);
     let gpu = GpuScene::with_origin(&ctx.device, &mut cmds, &scene, &CellParams::default(), DVec3::ZERO).unwrap();
     let rays: Vec<GpuRay> = probes.iter().map(|p| p.ray).collect();
-    let (hits, _) = ProbePass::new(&ctx.device, &gpu, &rays, INTERSECT_FULL, false).unwrap().run(&mut cmds).unwrap();
+    let (hits, _) =
+        ProbePass::new(&ctx.device, &gpu, &rays, IntersectMode::Full, false).unwrap().run(&mut cmds).unwrap();
     drop(gpu);
     drop(cmds);
     drop(ctx);

@@ -22,8 +22,9 @@ mod common;
 use glam::{DAffine3, DVec3};
 use quadray::geometry::{reference, CellParams, FunctionalObject, Quadric};
 use quadray::passes::gpu::GpuRay;
+use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
-use quadray::shader_interface::{INTERSECT_FULL, NO_HIT};
+use quadray::shader_interface::NO_HIT;
 use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -81,7 +82,7 @@ fn measure(
             GpuRay { origin: o.as_vec3().to_array(), tmin: 0.0, dir: d.as_vec3().to_array(), tmax: 1e30 }
         })
         .collect();
-    let (hits, _) = ProbePass::new(&ctx.device, &gpu, &rays, INTERSECT_FULL, false).unwrap().run(cmds).unwrap();
+    let (hits, _) = ProbePass::new(&ctx.device, &gpu, &rays, IntersectMode::Full, false).unwrap().run(cmds).unwrap();
     drop(gpu);
     let mut a = Agreement::default();
     let sil = SILHOUETTE_DEGREES.to_radians().sin();

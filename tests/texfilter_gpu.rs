@@ -17,7 +17,8 @@ use quadray::geometry::{FunctionalObject, Quadric};
 use quadray::passes::gpu::GpuTexQuery;
 use quadray::passes::{GpuScene, TexProbePass};
 use quadray::scene::{Material, MaterialMaps};
-use quadray::shader_interface::{LOOKUP_EWA, LOOKUP_PROBES};
+
+use quadray::passes::LookupMode;
 use quadray::texture::{bump_heights, checker, lean, normals_from_heights, TextureImage};
 use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
@@ -136,9 +137,9 @@ fn checker_cases() -> Vec<(f64, f64, DVec2, DVec2, DVec2)> {
     cases
 }
 
-/// Runs `lookup` (LOOKUP_EWA or LOOKUP_PROBES) on the checker cases and
+/// Runs `lookup` (LookupMode::Ewa or LookupMode::Probes) on the checker cases and
 /// checks each class's largest |error| against `bound(σ, anisotropy)`.
-fn check_lookup_on_the_checker(name: &str, lookup: u32, bound: impl Fn(f64, f64) -> f64) {
+fn check_lookup_on_the_checker(name: &str, lookup: LookupMode, bound: impl Fn(f64, f64) -> f64) {
     let scene = texture_scene(
         vec![checker(SIZE, CELLS, [1.0, 0.0, 0.0], [0.0, 0.0, 0.0])],
         MaterialMaps { albedo: Some(0), ..Default::default() },
@@ -186,7 +187,7 @@ fn check_lookup_on_the_checker(name: &str, lookup: u32, bound: impl Fn(f64, f64)
 
 #[test]
 fn ewa_matches_the_exact_gaussian_average_of_a_checkerboard() {
-    check_lookup_on_the_checker("EWA", LOOKUP_EWA, |sigma, aniso| {
+    check_lookup_on_the_checker("EWA", LookupMode::Ewa, |sigma, aniso| {
         if sigma >= WIDE_SIGMA {
             EWA_WIDE_TOLERANCE
         } else if sigma < 1.0 {
@@ -252,7 +253,7 @@ fn trilinear_probes_average_to_the_exact_gaussian_under_jitter() {
     let mut cmds = Commands::new(&ctx.device).unwrap();
     let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
     let results =
-        TexProbePass::with_lookup(&ctx.device, &gpu, &queries, LOOKUP_PROBES).unwrap().run(&mut cmds).unwrap();
+        TexProbePass::with_lookup(&ctx.device, &gpu, &queries, LookupMode::Probes).unwrap().run(&mut cmds).unwrap();
     drop(gpu);
     drop(cmds);
     drop(ctx);

@@ -22,7 +22,7 @@ use glam::{DAffine3, DVec2, DVec3, Vec3};
 use quadray::geometry::uv::object_uv;
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};
 use quadray::passes::RenderVariant;
-use quadray::scene::{FilterMode, Material, MaterialMaps, Scene, UvMapping, UvSettings};
+use quadray::scene::{FilterMode, ImageSettings, Material, MaterialMaps, Scene, UvMapping, UvSettings};
 use quadray::texture::encoding::TexelEncoding;
 use quadray::texture::{from_texels, MAX_TEXTURE_SIZE};
 
@@ -78,8 +78,8 @@ fn worst_albedo_errors(
     filter: FilterMode,
     expected: impl Fn(DVec2) -> Option<[f32; 3]>,
 ) -> ([f64; 3], usize) {
-    let variant = RenderVariant { filter: filter.constant(), ..Default::default() };
-    let out = common::render_variant_validated(scene, variant);
+    let scene = &Scene { image: ImageSettings { filter, ..scene.image.clone() }, ..scene.clone() };
+    let out = common::render_variant_validated(scene, RenderVariant::default());
     let (w, h) = SIZE;
     let [eye, forward, right, up] = quadray::passes::scene_gpu::camera_basis(scene, w, h);
     let (mut worst, mut checked) = ([0.0f64; 3], 0);

@@ -8,6 +8,7 @@ use super::render::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
 use quadray::output::{write_exr, ExrPrecision};
+use quadray::passes::{LookupMode, ShadingMode};
 use quadray::progress::ProgressBar;
 use quadray::scene::{parse_scene, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
@@ -168,10 +169,10 @@ pub(crate) enum Lookup {
 }
 
 impl Lookup {
-    fn constant(self) -> u32 {
+    fn mode(self) -> LookupMode {
         match self {
-            Self::Probes => quadray::shader_interface::LOOKUP_PROBES,
-            Self::Ewa => quadray::shader_interface::LOOKUP_EWA,
+            Self::Probes => LookupMode::Probes,
+            Self::Ewa => LookupMode::Ewa,
         }
     }
 }
@@ -197,11 +198,11 @@ pub(crate) fn filter_bench(args: FilterBenchArgs) -> Result<()> {
         reference_frame_spp: args.reference_frame_spp,
         pan_step: args.pan_step,
         shading: match args.shading {
-            BenchShading::Full => quadray::shader_interface::SHADING_FULL,
-            BenchShading::Albedo => quadray::shader_interface::SHADING_MIRRORED_ALBEDO,
-            BenchShading::GlossyAlbedo => quadray::shader_interface::SHADING_GLOSSY_ALBEDO,
+            BenchShading::Full => ShadingMode::Full,
+            BenchShading::Albedo => ShadingMode::MirroredAlbedo,
+            BenchShading::GlossyAlbedo => ShadingMode::GlossyAlbedo,
         },
-        lookup: args.lookup.constant(),
+        lookup: args.lookup.mode(),
         command,
     };
     if args.summarize_only {
@@ -359,7 +360,7 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
     let mut cmds = quadray::vk::Commands::new(device)?;
     let gpu = GpuScene::for_render(device, &mut cmds, &scene)?;
     let im = &scene.image;
-    let variant = RenderVariant { filter: im.filter.constant(), caustics: false, volume: false, ..Default::default() };
+    let variant = RenderVariant { caustics: false, volume: false, ..Default::default() };
     // Renders `spp` samples of `s` (this scene, perhaps with another seed).
     let render = |cmds: &mut quadray::vk::Commands, s: &Scene, spp: u32| {
         let mut progress = ProgressBar::new(false);

@@ -7,6 +7,7 @@ use super::common::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
 use quadray::output::write_outputs_with;
+use quadray::passes::{IntersectMode, ShadingMode};
 use quadray::progress::ProgressBar;
 use quadray::scene::{Scene, DEFAULT_SCENE_NAME};
 
@@ -160,16 +161,11 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
     }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
-    let filter = scene.image.filter.constant();
-    let variant = quadray::passes::RenderVariant {
-        filter,
-        caustics: !args.brute_force,
-        volume: !args.brute_force,
-        ..Default::default()
-    };
+    let variant =
+        quadray::passes::RenderVariant { caustics: !args.brute_force, volume: !args.brute_force, ..Default::default() };
     let mut interrupted = false;
     if args.bench {
-        let out = bench(&ctx, &scene, filter)?;
+        let out = bench(&ctx, &scene)?;
         write_render(&args, &ctx, &scene, variant, &outputs, None, &out, quadray::job::JobEnd::Complete)?;
     } else {
         let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -318,9 +314,9 @@ pub(crate) fn write_render(
 }
 
 /// The benchmark mode of `render --bench`; returns the full render.
-pub(crate) fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> Result<quadray::passes::RenderOutput> {
+pub(crate) fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray::passes::RenderOutput> {
     use quadray::passes::{render, GpuScene, RenderVariant};
-    use quadray::shader_interface::{INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, SHADING_FULL, SHADING_NONE};
+
     let device = &ctx.device;
     let mut cmds = quadray::vk::Commands::new(device)?;
     let gpu = GpuScene::for_render(device, &mut cmds, scene)?;
@@ -328,19 +324,19 @@ pub(crate) fn bench(ctx: &quadray::vk::Context, scene: &Scene, filter: u32) -> R
     let variants = [
         (
             "full render",
-            RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_FULL, filter, ..Default::default() },
+            RenderVariant { intersect: IntersectMode::Full, shading: ShadingMode::Full, ..Default::default() },
         ),
         (
             "perturbation root finding off",
-            RenderVariant { intersect: INTERSECT_BASE, shading: SHADING_FULL, filter, ..Default::default() },
+            RenderVariant { intersect: IntersectMode::Base, shading: ShadingMode::Full, ..Default::default() },
         ),
         (
             "shading and secondary rays off",
-            RenderVariant { intersect: INTERSECT_FULL, shading: SHADING_NONE, filter, ..Default::default() },
+            RenderVariant { intersect: IntersectMode::Full, shading: ShadingMode::Albedo, ..Default::default() },
         ),
         (
             "traversal only (boxes are hits, no shading)",
-            RenderVariant { intersect: INTERSECT_BOXES, shading: SHADING_NONE, filter, ..Default::default() },
+            RenderVariant { intersect: IntersectMode::Boxes, shading: ShadingMode::Albedo, ..Default::default() },
         ),
     ];
     eprintln!(

@@ -12,10 +12,10 @@ use crate::output::{write_all_or_nothing, write_png};
 use crate::passes::render::PIXEL_FILTER_SIGMA;
 use crate::passes::{render, GpuScene, RenderOutput, RenderVariant};
 use crate::scene::{load_scene, Scene};
-use crate::shader_interface::{FILTER_NONE, SHADING_FULL};
 use crate::vk::{Commands, Context};
 
 use super::*;
+use crate::passes::ShadingMode;
 
 /// The renderer state shared by a scene's renders.
 pub(super) struct Bench<'a> {
@@ -24,22 +24,29 @@ pub(super) struct Bench<'a> {
     pub(super) gpu: GpuScene,
     pub(super) scene: Scene,
     pub(super) size: (u32, u32),
-    pub(super) shading: u32,
-    pub(super) lookup: u32,
+    pub(super) shading: ShadingMode,
+    pub(super) lookup: LookupMode,
 }
 
 impl Bench<'_> {
     /// Renders with `filter` at `spp`, the camera moved by `offset` along its
     /// right vector.
-    pub(super) fn render(&mut self, filter: u32, spp: u32, seed: u32, offset: f64) -> Result<RenderOutput, BenchError> {
+    pub(super) fn render(
+        &mut self,
+        filter: FilterMode,
+        spp: u32,
+        seed: u32,
+        offset: f64,
+    ) -> Result<RenderOutput, BenchError> {
         let mut scene = self.scene.clone();
         scene.image.seed = seed;
+        scene.image.filter = filter;
         let c = &mut scene.camera;
         let right = (c.look_at - c.position).cross(c.up).normalize_or(DVec3::X);
         c.position += right * offset;
         c.look_at += right * offset;
         let (w, h) = self.size;
-        let variant = self.variant(filter);
+        let variant = self.variant();
         Ok(render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, (w, h, spp), variant, &mut |_, _| {})?)
     }
 
@@ -50,16 +57,18 @@ impl Bench<'_> {
         Ok(std::mem::replace(&mut self.scene, scene))
     }
 
-    /// The render shader variant of `filter` with the bench's shading and lookup.
-    pub(super) fn variant(&self, filter: u32) -> RenderVariant {
-        RenderVariant { filter, shading: self.shading, lookup: self.lookup, ..Default::default() }
+    /// The render shader variant with the bench's shading and lookup.
+    pub(super) fn variant(&self) -> RenderVariant {
+        RenderVariant { shading: self.shading, lookup: self.lookup, ..Default::default() }
     }
 
     /// An untimed 8x8 render that makes lavapipe compile `filter`'s shader
     /// variant (it does so at the first dispatch) before the timed renders.
-    pub(super) fn warm_up(&mut self, filter: u32) -> Result<(), BenchError> {
-        let variant = self.variant(filter);
-        render(&self.ctx.device, &mut self.cmds, &self.gpu, &self.scene, (8, 8, 1), variant, &mut |_, _| {})?;
+    pub(super) fn warm_up(&mut self, filter: FilterMode) -> Result<(), BenchError> {
+        let variant = self.variant();
+        let mut scene = self.scene.clone();
+        scene.image.filter = filter;
+        render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, (8, 8, 1), variant, &mut |_, _| {})?;
         Ok(())
     }
 }
@@ -210,8 +219,8 @@ pub(super) fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result
     let mut bench = Bench { ctx, cmds, gpu, scene, size, shading: config.shading, lookup: config.lookup };
     let seed = bench.scene.image.seed;
     let cache = config.out_dir.join("cache");
-    if config.shading != SHADING_FULL {
-        eprintln!("{stem}: shading variant {}: texture transport alone, no lighting", config.shading);
+    if config.shading != ShadingMode::Full {
+        eprintln!("{stem}: shading variant {:?}: texture transport alone, no lighting", config.shading);
     }
     std::fs::create_dir_all(&cache).map_err(io_error(&cache))?;
     let pixels = (config.width * config.height) as usize;
@@ -224,7 +233,7 @@ pub(super) fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result
         spp,
         seed,
         camera_offset: offset,
-        shading: config.shading,
+        shading: config.shading.constant(),
         pixel_sigma: PIXEL_FILTER_SIGMA,
         version: env!("CARGO_PKG_VERSION").into(),
         seconds: 0.0,
@@ -232,12 +241,12 @@ pub(super) fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result
     let half = config.reference_spp / 2;
     let (a, reference_info) = cached_reference(
         &mut bench,
-        &cache.join(format!("{stem}-s{}-reference-a", config.shading)),
+        &cache.join(format!("{stem}-s{}-reference-a", config.shading.constant())),
         key(half, seed.wrapping_add(1_000_003), 0.0),
     )?;
     let (b, _) = cached_reference(
         &mut bench,
-        &cache.join(format!("{stem}-s{}-reference-b", config.shading)),
+        &cache.join(format!("{stem}-s{}-reference-b", config.shading.constant())),
         key(half, seed.wrapping_add(2_000_003), 0.0),
     )?;
     let reference = Reference::new(&a, &b);
@@ -285,13 +294,13 @@ pub(super) fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result
 
     // The maps' share of none's error, and the texture mask, at each target.
     let textured = bench.replace_scene(with_mean_maps(&bench.scene))?;
-    bench.warm_up(FILTER_NONE)?;
+    bench.warm_up(FilterMode::None)?;
     let mut shares = Vec::new();
     let mut mask = vec![false; pixels];
     for (i, &t) in targets.iter().enumerate() {
         let mut acc = Accumulation::new(pixels);
         for s in 0..config.seeds {
-            acc.add(&bench.render(FILTER_NONE, t, seed.wrapping_add(3_000_017 + s * 7919), 0.0)?);
+            acc.add(&bench.render(FilterMode::None, t, seed.wrapping_add(3_000_017 + s * 7919), 0.0)?);
         }
         let none = &accumulations.iter().find(|(m, spp, _)| m == "none" && *spp == t).expect("none ran").2;
         let lighting: f64 =
@@ -440,7 +449,7 @@ pub(super) fn temporal_stability(
     };
     let mut reference_frames = Vec::new();
     for (k, &offset) in offsets.iter().enumerate() {
-        let path = cache.join(format!("{stem}-s{}-pan{k}", config.shading));
+        let path = cache.join(format!("{stem}-s{}-pan{k}", config.shading.constant()));
         reference_frames
             .push(cached_reference(bench, &path, key(config.reference_frame_spp, bench.scene.image.seed, offset))?.0);
     }
@@ -513,7 +522,7 @@ pub(super) fn cached_reference(
         }
     }
     eprintln!("{}: rendering the reference ({} spp, filtering none)...", base.display(), info.spp);
-    let out = bench.render(FILTER_NONE, info.spp, info.seed, info.camera_offset)?;
+    let out = bench.render(FilterMode::None, info.spp, info.seed, info.camera_offset)?;
     eprintln!("{}: reference took {:.1} s", base.display(), out.seconds);
     let stored = ReferenceInfo { seconds: out.seconds, ..info };
     let bytes: Vec<u8> = out.radiance.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();

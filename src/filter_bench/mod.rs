@@ -43,8 +43,9 @@ mod tests;
 use std::path::{Path, PathBuf};
 
 use crate::metrics::MetricError;
+use crate::passes::{LookupMode, ShadingMode};
 use crate::plot::PlotError;
-use crate::shader_interface::{FILTER_COVARIANCE, FILTER_NONE, FILTER_RAY_CONES, LOOKUP_PROBES, SHADING_FULL};
+use crate::scene::FilterMode;
 use crate::vk::Context;
 use crate::RenderError;
 
@@ -52,8 +53,8 @@ pub use measure::*;
 pub use report::*;
 
 /// The filtering modes, by their CLI names.
-pub const MODES: [(&str, u32); 3] =
-    [("none", FILTER_NONE), ("ray-cones", FILTER_RAY_CONES), ("covariance", FILTER_COVARIANCE)];
+pub const MODES: [(&str, FilterMode); 3] =
+    [("none", FilterMode::None), ("ray-cones", FilterMode::RayCones), ("covariance", FilterMode::Covariance)];
 
 /// "Equal quality": error at most the target's and bias² at most this
 /// fraction of it.
@@ -91,13 +92,13 @@ pub struct Config {
     /// Camera motion per frame, as a fraction of the distance from the
     /// camera to its look-at point, along the camera's right vector.
     pub pan_step: f64,
-    /// The render shader's shading: `SHADING_FULL` (the path tracer),
-    /// `SHADING_MIRRORED_ALBEDO` (the albedo seen directly and through
-    /// perfect mirrors) or `SHADING_GLOSSY_ALBEDO` (also through glossy
+    /// The render shader's shading: `ShadingMode::Full` (the path tracer),
+    /// `ShadingMode::MirroredAlbedo` (the albedo seen directly and through
+    /// perfect mirrors) or `ShadingMode::GlossyAlbedo` (also through glossy
     /// reflections and refractions); the albedo modes have no lighting.
-    pub shading: u32,
-    /// The filtered modes' lookup: `LOOKUP_PROBES` or `LOOKUP_EWA`.
-    pub lookup: u32,
+    pub shading: ShadingMode,
+    /// The filtered modes' lookup: `LookupMode::Probes` or `LookupMode::Ewa`.
+    pub lookup: LookupMode,
     /// The command line, recorded in the reports.
     pub command: String,
 }
@@ -117,8 +118,8 @@ impl Default for Config {
             frame_spp: 4,
             reference_frame_spp: 256,
             pan_step: 0.004,
-            shading: SHADING_FULL,
-            lookup: LOOKUP_PROBES,
+            shading: ShadingMode::Full,
+            lookup: LookupMode::Probes,
             command: String::new(),
         }
     }

@@ -26,6 +26,7 @@ use glam::{DVec2, DVec3};
 
 use super::gpu::{CausticPush, GpuCausticRay, GpuEmitter, GpuReceiver};
 use super::scene_gpu::GpuScene;
+use super::IntersectMode;
 use crate::geometry::CellParams;
 use crate::scene::{Light, Scene};
 use crate::shader_interface::{
@@ -268,7 +269,7 @@ impl CausticMap {
         let map = Buffer::storage(device, "caustic map", pixels * 24, MemoryLocation::GpuToCpu)?;
         let beams = Buffer::storage(device, "beam map", pixels * 24, MemoryLocation::GpuToCpu)?;
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
-        let intersect = gpu.intersect_mode(crate::shader_interface::INTERSECT_FULL);
+        let intersect = gpu.intersect_mode(IntersectMode::Full).constant();
         let traced = [(SPEC_INTERSECT_MODE, intersect)];
         let gbuffer = ComputePipeline::new(device, &shaders::gbuffer(), &traced)?;
         let trace = ComputePipeline::new(

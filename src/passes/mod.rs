@@ -10,13 +10,15 @@ pub mod probe;
 pub mod render;
 pub mod scene_gpu;
 pub mod texprobe;
+pub mod variant;
 pub mod volume;
 
 pub use bounds::{PixelBounds, TileIndex};
 pub use caustics::{CausticMap, CausticReport};
 pub use checkpoint::{Accumulation, Checkpoint};
 pub use probe::ProbePass;
-pub use render::{render, RecordedPath, RenderOutput, RenderVariant, Renderer};
+pub use render::{render, RecordedPath, RenderOutput, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene};
 pub use texprobe::TexProbePass;
+pub use variant::{IntersectMode, LookupMode, RenderVariant, ShadingMode};
 pub use volume::VolumeLight;

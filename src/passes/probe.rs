@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use super::gpu::{GpuHit, GpuRay, ProbePush};
 use super::scene_gpu::GpuScene;
+use super::IntersectMode;
 use crate::shader_interface::{
     BINDING_PROBE_HITS, BINDING_PROBE_RAYS, PROBE_GROUP, SPEC_INTERSECT_MODE, SPEC_PROBE_CURVATURE,
 };
@@ -25,19 +26,19 @@ pub struct ProbePass {
 
 impl ProbePass {
     /// Uploads `rays` and binds them with the scene; `mode` is one of the
-    /// `INTERSECT_*` constants (`INTERSECT_FULL` for the real intersection);
+    /// `INTERSECT_*` constants (`IntersectMode::Full` for the real intersection);
     /// `curvature` asks for the hits' curvatures (zero otherwise).
     pub fn new(
         device: &Arc<Device>,
         scene: &GpuScene,
         rays: &[GpuRay],
-        mode: u32,
+        mode: IntersectMode,
         curvature: bool,
     ) -> Result<Self, RenderError> {
         let pipeline = ComputePipeline::new(
             device,
             &shaders::probe(),
-            &[(SPEC_INTERSECT_MODE, mode), (SPEC_PROBE_CURVATURE, u32::from(curvature))],
+            &[(SPEC_INTERSECT_MODE, mode.constant()), (SPEC_PROBE_CURVATURE, u32::from(curvature))],
         )?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::storage(

@@ -10,13 +10,13 @@ use super::checkpoint::Accumulation;
 use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathRecord, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::volume::VolumeLight;
+use super::{RenderVariant, ShadingMode};
 use crate::scene::Scene;
 use crate::shader_interface::{
     BINDING_ACCUM, BINDING_AOV, BINDING_ENV_CDF, BINDING_RENDER_BEAMS, BINDING_RENDER_CAUSTICS, BINDING_RENDER_GBUFFER,
-    BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, BINDING_RENDER_VOLUME, FILTER_NONE, INTERSECT_FULL, LOOKUP_PROBES,
-    NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP, SHADING_FULL, SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED,
-    SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE, SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SHADING_MODE,
-    SPEC_VOLUME_ENABLED,
+    BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, BINDING_RENDER_VOLUME, NO_TEXTURE, PATH_RECORD_VERTICES,
+    RENDER_GROUP, SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED, SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE,
+    SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
 };
 use crate::vk::{
     full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
@@ -101,46 +101,6 @@ pub struct RecordedPath {
 
 /// Progress of a render: (work done, total work), in tile-samples.
 pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
-
-/// Variants of the render shader that switch parts of the work off, to
-/// measure what bounds a render (the benchmark mode). `Default` renders.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RenderVariant {
-    /// `INTERSECT_FULL`, `INTERSECT_BASE` (perturbation root finding off) or
-    /// `INTERSECT_BOXES` (every candidate box is a hit: traversal only).
-    pub intersect: u32,
-    /// `SHADING_FULL` or `SHADING_NONE` (the first hit's albedo: no light
-    /// sampling, no shadow rays, no bounces).
-    pub shading: u32,
-    /// Texture filtering: `FILTER_NONE`, `FILTER_RAY_CONES` or `FILTER_COVARIANCE`.
-    pub filter: u32,
-    /// Run the caustic passes when the scene needs them (false: the path
-    /// tracer alone estimates caustics, by brute force).
-    pub caustics: bool,
-    /// Run the volume pass when the scene needs it (false: the path tracer
-    /// alone estimates the light scattered by the fog).
-    pub volume: bool,
-    /// Record the events of one pixel's path ([`Renderer::trace_path`]);
-    /// false compiles the recording out.
-    pub record_path: bool,
-    /// The filtered modes' texture lookup: `LOOKUP_PROBES` (the default) or
-    /// `LOOKUP_EWA` (the reference lookup).
-    pub lookup: u32,
-}
-
-impl Default for RenderVariant {
-    fn default() -> Self {
-        Self {
-            intersect: INTERSECT_FULL,
-            shading: SHADING_FULL,
-            filter: FILTER_NONE,
-            caustics: true,
-            volume: true,
-            record_path: false,
-            lookup: LOOKUP_PROBES,
-        }
-    }
-}
 
 /// Renders `scene` at `width` x `height` with `spp` samples per pixel.
 pub fn render(
@@ -291,7 +251,7 @@ impl Renderer {
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )?;
         let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant)?;
-        let volume = if variant.volume && variant.shading == SHADING_FULL && scene.needs_volume() {
+        let volume = if variant.volume && variant.shading == ShadingMode::Full && scene.needs_volume() {
             Some(VolumeLight::new(device, gpu, &frame, (width, height))?)
         } else {
             None
@@ -668,15 +628,15 @@ fn render_pipeline(
         device,
         &shaders::render(),
         &[
-            (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect)),
-            (SPEC_SHADING_MODE, variant.shading),
-            (SPEC_FILTER_MODE, variant.filter),
+            (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect).constant()),
+            (SPEC_SHADING_MODE, variant.shading.constant()),
+            (SPEC_FILTER_MODE, scene.image.filter.constant()),
             (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),
             (SPEC_CAUSTICS_ENABLED, u32::from(caustics.is_some())),
             (SPEC_VOLUME_ENABLED, u32::from(volume)),
             (SPEC_BEAMS_ENABLED, u32::from(caustics.is_some_and(|c| c.has_beams))),
             (SPEC_RECORD_PATH, u32::from(variant.record_path)),
-            (SPEC_LOOKUP_MODE, variant.lookup),
+            (SPEC_LOOKUP_MODE, variant.lookup.constant()),
         ],
     )?)
 }
@@ -694,7 +654,7 @@ fn caustic_map(
     variant: RenderVariant,
 ) -> Result<Option<CausticMap>, RenderError> {
     let max_depth = scene.image.max_depth.max(1);
-    if !variant.caustics || variant.shading != SHADING_FULL || !scene.needs_caustics() || max_depth < 2 {
+    if !variant.caustics || variant.shading != ShadingMode::Full || !scene.needs_caustics() || max_depth < 2 {
         return Ok(None);
     }
     // A caustic path from the camera: the receiver (a bounce), the specular

@@ -8,12 +8,13 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3};
 
 use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
+use super::IntersectMode;
 use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Scene, TextureImage};
 use crate::shader_interface::{
     BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_MATERIALS, BINDING_OBJECTS,
-    BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, INTERSECT_BASE, INTERSECT_FULL, MAX_TEXTURES,
+    BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES,
 };
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::texture::lean;
@@ -363,12 +364,12 @@ impl GpuScene {
 
     /// The intersection mode to specialise shaders with: `requested`, except
     /// that a scene without perturbations needs no more than the base
-    /// quadrics' roots (`INTERSECT_BASE`, the same hits), which leaves the
+    /// quadrics' roots (`IntersectMode::Base`, the same hits), which leaves the
     /// perturbation code and its f64 root refinement out of the shaders:
     /// they compile several times faster on lavapipe.
-    pub fn intersect_mode(&self, requested: u32) -> u32 {
-        if requested == INTERSECT_FULL && self.stats.perturbations == 0 {
-            INTERSECT_BASE
+    pub fn intersect_mode(&self, requested: IntersectMode) -> IntersectMode {
+        if requested == IntersectMode::Full && self.stats.perturbations == 0 {
+            IntersectMode::Base
         } else {
             requested
         }

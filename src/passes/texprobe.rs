@@ -6,9 +6,8 @@ use std::sync::Arc;
 
 use super::gpu::{GpuTexQuery, GpuTexResult, ProbePush};
 use super::scene_gpu::GpuScene;
-use crate::shader_interface::{
-    BINDING_TEXPROBE_QUERIES, BINDING_TEXPROBE_RESULTS, LOOKUP_EWA, PROBE_GROUP, SPEC_LOOKUP_MODE,
-};
+use super::LookupMode;
+use crate::shader_interface::{BINDING_TEXPROBE_QUERIES, BINDING_TEXPROBE_RESULTS, PROBE_GROUP, SPEC_LOOKUP_MODE};
 use crate::vk::{vk, Binding, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
 use crate::{shaders, RenderError};
 
@@ -26,17 +25,17 @@ pub struct TexProbePass {
 impl TexProbePass {
     /// Uploads `queries` and binds them with the scene's textures; EWA lookups.
     pub fn new(device: &Arc<Device>, scene: &GpuScene, queries: &[GpuTexQuery]) -> Result<Self, RenderError> {
-        Self::with_lookup(device, scene, queries, LOOKUP_EWA)
+        Self::with_lookup(device, scene, queries, LookupMode::Ewa)
     }
 
-    /// As [`TexProbePass::new`], with the lookup `LOOKUP_EWA` or `LOOKUP_PROBES`.
+    /// As [`TexProbePass::new`], with the lookup `LookupMode::Ewa` or `LookupMode::Probes`.
     pub fn with_lookup(
         device: &Arc<Device>,
         scene: &GpuScene,
         queries: &[GpuTexQuery],
-        lookup: u32,
+        lookup: LookupMode,
     ) -> Result<Self, RenderError> {
-        let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &[(SPEC_LOOKUP_MODE, lookup)])?;
+        let pipeline = ComputePipeline::new(device, &shaders::texprobe(), &[(SPEC_LOOKUP_MODE, lookup.constant())])?;
         let query_buf = Buffer::with_data(device, "texture queries", queries, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let results = Buffer::storage(
             device,

@@ -9,7 +9,8 @@ use std::sync::Arc;
 
 use super::gpu::VolumePush;
 use super::scene_gpu::GpuScene;
-use crate::shader_interface::{BINDING_VOLUME, INTERSECT_FULL, RENDER_GROUP, SPEC_INTERSECT_MODE};
+use super::IntersectMode;
+use crate::shader_interface::{BINDING_VOLUME, RENDER_GROUP, SPEC_INTERSECT_MODE};
 use crate::vk::{full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation};
 use crate::{shaders, RenderError};
 
@@ -56,7 +57,7 @@ impl VolumeLight {
         let pipeline = ComputePipeline::new(
             device,
             &shaders::volume(),
-            &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(INTERSECT_FULL))],
+            &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant())],
         )?;
         let mut bindings = gpu.frame_bindings(frame);
         bindings.push((BINDING_VOLUME, Binding::Buffer(&radiance)));

@@ -151,12 +151,8 @@ struct App {
 impl App {
     fn new(config: ViewerConfig) -> Self {
         let scene = config.scene.clone();
-        let variant = RenderVariant {
-            filter: scene.image.filter.constant(),
-            caustics: !config.brute_force,
-            volume: !config.brute_force,
-            ..Default::default()
-        };
+        let variant =
+            RenderVariant { caustics: !config.brute_force, volume: !config.brute_force, ..Default::default() };
         Self {
             camera: CameraController::new(&scene.camera),
             scene,
@@ -214,7 +210,6 @@ impl App {
         match action {
             Action::CycleFilter => {
                 self.scene.image.filter = self.scene.image.filter.next();
-                self.variant.filter = self.scene.image.filter.constant();
                 self.dirty.renderer = true;
             }
             Action::NextPreset => {
@@ -283,7 +278,6 @@ impl App {
         self.scene.apply_preset(preset);
         (self.scene.image.width, self.scene.image.height, self.scene.image.seed, self.scene.image.exposure) =
             (w, h, seed, exposure);
-        self.variant.filter = self.scene.image.filter.constant();
         self.dirty.renderer = true;
     }
 

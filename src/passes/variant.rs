@@ -1,0 +1,119 @@
+//! The switches of the render shader beside the scene's own settings: the
+//! benchmark breakdowns (intersection and shading modes), the texture
+//! lookup of the filtered modes, the passes to run and path recording. The
+//! scene carries everything else (size, samples, depth, filter, seed), and
+//! every render entry point takes it from there.
+
+use crate::shader_interface::{
+    INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, LOOKUP_EWA, LOOKUP_PROBES, SHADING_FULL, SHADING_GLOSSY_ALBEDO,
+    SHADING_MIRRORED_ALBEDO, SHADING_NONE,
+};
+
+/// How candidate boxes are intersected (`SPEC_INTERSECT_MODE`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum IntersectMode {
+    /// The exact first root of F' (the renderer's mode).
+    #[default]
+    Full,
+    /// Perturbations ignored: the base quadric's roots in each box.
+    Base,
+    /// Every candidate box is a hit where the ray enters it (traversal cost
+    /// only).
+    Boxes,
+}
+
+impl IntersectMode {
+    /// The `INTERSECT_*` value the shaders are specialised with.
+    pub fn constant(self) -> u32 {
+        match self {
+            Self::Full => INTERSECT_FULL,
+            Self::Base => INTERSECT_BASE,
+            Self::Boxes => INTERSECT_BOXES,
+        }
+    }
+}
+
+/// What the render shader computes at a hit (`SPEC_SHADING_MODE`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ShadingMode {
+    /// The path tracer (the renderer's mode).
+    #[default]
+    Full,
+    /// The first hit's albedo only: no light sampling, shadow rays or
+    /// bounces (benchmark breakdowns).
+    Albedo,
+    /// The albedo of the first hit that is not a perfect mirror (filtering
+    /// tests through mirrors).
+    MirroredAlbedo,
+    /// The albedo seen through glossy reflections (filtering tests).
+    GlossyAlbedo,
+}
+
+impl ShadingMode {
+    /// The `SHADING_*` value the render shader is specialised with.
+    pub fn constant(self) -> u32 {
+        match self {
+            Self::Full => SHADING_FULL,
+            Self::Albedo => SHADING_NONE,
+            Self::MirroredAlbedo => SHADING_MIRRORED_ALBEDO,
+            Self::GlossyAlbedo => SHADING_GLOSSY_ALBEDO,
+        }
+    }
+}
+
+/// The texture lookup of the filtered modes (`SPEC_LOOKUP_MODE`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum LookupMode {
+    /// Trilinear probes along the footprint's major axis (the renderer's
+    /// lookup).
+    #[default]
+    Probes,
+    /// Elliptical weighted average (the reference lookup).
+    Ewa,
+}
+
+impl LookupMode {
+    /// The `LOOKUP_*` value the shaders are specialised with.
+    pub fn constant(self) -> u32 {
+        match self {
+            Self::Probes => LOOKUP_PROBES,
+            Self::Ewa => LOOKUP_EWA,
+        }
+    }
+}
+
+/// Variants of the render shader that switch parts of the work off, to
+/// measure what bounds a render (the benchmark mode) or to test parts of it.
+/// `Default` renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderVariant {
+    /// How candidate boxes are intersected.
+    pub intersect: IntersectMode,
+    /// What is computed at a hit.
+    pub shading: ShadingMode,
+    /// Run the caustic passes when the scene needs them (false: the path
+    /// tracer alone estimates caustics, by brute force).
+    pub caustics: bool,
+    /// Run the volume pass when the scene needs it (false: the path tracer
+    /// alone estimates the light scattered by the fog).
+    pub volume: bool,
+    /// Record the events of one pixel's path
+    /// ([`Renderer::trace_path`](super::Renderer::trace_path)); false
+    /// compiles the recording out.
+    pub record_path: bool,
+    /// The filtered modes' texture lookup.
+    pub lookup: LookupMode,
+}
+
+impl Default for RenderVariant {
+    fn default() -> Self {
+        Self {
+            intersect: IntersectMode::Full,
+            shading: ShadingMode::Full,
+            caustics: true,
+            volume: true,
+            record_path: false,
+            lookup: LookupMode::Probes,
+        }
+    }
+}
