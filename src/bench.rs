@@ -174,11 +174,11 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
             let variant = RenderVariant::default();
             let im = &scene.image;
             // Untimed warm-up: compiles every pipeline this quality uses.
-            render(device, &mut cmds, &gpu, scene, (8, 8, 1), variant, &mut |_, _| {})
+            render(device, &mut cmds, &gpu, &scene.resized(8, 8, 1), variant, &mut |_, _| {})
                 .map_err(|e| render_error(&s.name, e))?;
             let work = im.width as u64 * im.height as u64 * im.spp as u64;
             let start = Instant::now();
-            let out = render(device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), variant, &mut |d, t| {
+            let out = render(device, &mut cmds, &gpu, scene, variant, &mut |d, t| {
                 bar.update(*done + work * d / t.max(1), total)
             })
             .map_err(|e| render_error(&s.name, e))?;

@@ -522,11 +522,7 @@ fn shell_quote(s: &str) -> String {
 /// Writes `bytes` to `path` through a temporary file in the same folder and
 /// a rename.
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FarmError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(format!(".tmp{}", std::process::id()));
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes).map_err(io(&tmp))?;
-    std::fs::rename(&tmp, path).map_err(io(path))
+    crate::output::write_file_atomically(path, bytes).map_err(io(path))
 }
 
 #[cfg(test)]

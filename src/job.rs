@@ -115,11 +115,9 @@ impl Job {
         variant: RenderVariant,
         bounds: PixelBounds,
     ) -> Result<Self, JobError> {
-        let im = &scene.image;
         let mut cmds = vk::Commands::new(&ctx.device).map_err(RenderError::from)?;
         let gpu = GpuScene::for_render(&ctx.device, &mut cmds, scene)?;
-        let renderer =
-            Renderer::with_bounds(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), bounds, variant)?;
+        let renderer = Renderer::with_bounds(&ctx.device, &mut cmds, &gpu, scene, bounds, variant)?;
         Ok(Self { renderer, gpu, cmds, variant, bounds, fresh: true })
     }
 

@@ -88,6 +88,5 @@ pub fn render_scene_with(
 ) -> Result<passes::RenderOutput, RenderError> {
     let mut cmds = vk::Commands::new(&ctx.device)?;
     let gpu = passes::GpuScene::for_render(&ctx.device, &mut cmds, scene)?;
-    let im = &scene.image;
-    passes::render(&ctx.device, &mut cmds, &gpu, scene, (im.width, im.height, im.spp), variant, progress)
+    passes::render(&ctx.device, &mut cmds, &gpu, scene, variant, progress)
 }

@@ -80,6 +80,12 @@ pub fn write_all_or_nothing(paths: &[PathBuf], write: impl Fn(usize, &Path) -> i
     result
 }
 
+/// Writes `bytes` to `path` through a temporary file beside it and a rename:
+/// readers see the old file or the new one, never a part.
+pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_all_or_nothing(&[path.to_path_buf()], |_, tmp| std::fs::write(tmp, bytes))
+}
+
 /// Writes the render to every file of `files`, all or nothing.
 pub fn write_outputs(out: &RenderOutput, files: &[(PathBuf, OutputKind)]) -> io::Result<()> {
     write_outputs_with(out, files, &[])

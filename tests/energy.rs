@@ -38,9 +38,8 @@ fn upload(ctx: &Context, cmds: &mut Commands, scene: &Scene) -> GpuScene {
 fn render(ctx: &Context, scene: &Scene, (width, height, spp): (u32, u32, u32)) -> RenderOutput {
     let mut cmds = Commands::new(&ctx.device).unwrap();
     let gpu = upload(ctx, &mut cmds, scene);
-    let out =
-        quadray::passes::render(&ctx.device, &mut cmds, &gpu, scene, (width, height, spp), BRUTE_FORCE, &mut |_, _| {})
-            .unwrap();
+    let scene = scene.resized(width, height, spp);
+    let out = quadray::passes::render(&ctx.device, &mut cmds, &gpu, &scene, BRUTE_FORCE, &mut |_, _| {}).unwrap();
     common::finite(out)
 }
 
@@ -53,7 +52,8 @@ fn no_sample_exceeds_its_bound_in_the_stress_scene() {
     let counters = ctx.counters();
     let mut cmds = Commands::new(&ctx.device).unwrap();
     let gpu = upload(&ctx, &mut cmds, &scene);
-    let mut renderer = Renderer::new(&ctx.device, &mut cmds, &gpu, &scene, (width, height, spp), BRUTE_FORCE).unwrap();
+    let sized = scene.resized(width, height, spp);
+    let mut renderer = Renderer::new(&ctx.device, &mut cmds, &gpu, &sized, BRUTE_FORCE).unwrap();
     let (mut samples, mut largest, mut over) = (0u64, 0f32, Vec::new());
     for s in 0..seeds {
         scene.image.seed = 1 + 7919 * s;
@@ -78,7 +78,8 @@ fn no_sample_exceeds_its_bound_in_the_stress_scene() {
     // The worst ones, traced again with their random numbers, for the log.
     if !over.is_empty() {
         let record = RenderVariant { record_path: true, ..BRUTE_FORCE };
-        let mut recorder = Renderer::new(&ctx.device, &mut cmds, &gpu, &scene, (width, height, 1), record).unwrap();
+        let mut recorder =
+            Renderer::new(&ctx.device, &mut cmds, &gpu, &scene.resized(width, height, 1), record).unwrap();
         for (seed, o) in over.iter().take(3) {
             scene.image.seed = *seed;
             recorder.set_camera(&mut cmds, &gpu, &scene).unwrap();
@@ -111,8 +112,7 @@ fn the_largest_sample_aov_is_a_sample_the_recorder_reproduces() {
             &ctx.device,
             &mut cmds,
             &gpu,
-            &scene,
-            (width, height, spp),
+            &scene.resized(width, height, spp),
             BRUTE_FORCE,
             &mut |_, _| {},
         )
@@ -125,7 +125,7 @@ fn the_largest_sample_aov_is_a_sample_the_recorder_reproduces() {
         assert!(m[1] < spp as f32 && m[1].fract() == 0.0);
     }
     let record = RenderVariant { record_path: true, ..BRUTE_FORCE };
-    let mut recorder = Renderer::new(&ctx.device, &mut cmds, &gpu, &scene, (width, height, 1), record).unwrap();
+    let mut recorder = Renderer::new(&ctx.device, &mut cmds, &gpu, &scene.resized(width, height, 1), record).unwrap();
     // The brightest pixels, and some others.
     let mut order: Vec<usize> = (0..out.max_sample.len()).collect();
     order.sort_by(|&a, &b| out.max_sample[b][0].total_cmp(&out.max_sample[a][0]));

@@ -364,9 +364,8 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
     // Renders `spp` samples of `s` (this scene, perhaps with another seed).
     let render = |cmds: &mut quadray::vk::Commands, s: &Scene, spp: u32| {
         let mut progress = ProgressBar::new(false);
-        let out = quadray::passes::render(device, cmds, &gpu, s, (im.width, im.height, spp), variant, &mut |d, t| {
-            progress.update(d, t)
-        });
+        let s = s.resized(im.width, im.height, spp);
+        let out = quadray::passes::render(device, cmds, &gpu, &s, variant, &mut |d, t| progress.update(d, t));
         progress.finish();
         out
     };
@@ -385,7 +384,7 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
     }
     if !found.is_empty() && args.worst > 0 {
         let record = RenderVariant { record_path: true, ..variant };
-        let mut recorder = Renderer::new(device, &mut cmds, &gpu, &scene, (im.width, im.height, 1), record)?;
+        let mut recorder = Renderer::new(device, &mut cmds, &gpu, &scene.resized(im.width, im.height, 1), record)?;
         for o in found.iter().take(args.worst) {
             let path = recorder.trace_path(&mut cmds, (o.x, o.y), o.sample)?;
             println!("\npixel ({}, {}), sample {} (luminance {:.4}):", o.x, o.y, o.sample, o.luminance);

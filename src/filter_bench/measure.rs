@@ -45,9 +45,9 @@ impl Bench<'_> {
         let right = (c.look_at - c.position).cross(c.up).normalize_or(DVec3::X);
         c.position += right * offset;
         c.look_at += right * offset;
-        let (w, h) = self.size;
+        (scene.image.width, scene.image.height, scene.image.spp) = (self.size.0, self.size.1, spp);
         let variant = self.variant();
-        Ok(render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, (w, h, spp), variant, &mut |_, _| {})?)
+        Ok(render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, variant, &mut |_, _| {})?)
     }
 
     /// Uploads `scene` in place of the bench's scene, and returns that one.
@@ -66,9 +66,9 @@ impl Bench<'_> {
     /// variant (it does so at the first dispatch) before the timed renders.
     pub(super) fn warm_up(&mut self, filter: FilterMode) -> Result<(), BenchError> {
         let variant = self.variant();
-        let mut scene = self.scene.clone();
+        let mut scene = self.scene.resized(8, 8, 1);
         scene.image.filter = filter;
-        render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, (8, 8, 1), variant, &mut |_, _| {})?;
+        render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, variant, &mut |_, _| {})?;
         Ok(())
     }
 }

@@ -102,18 +102,18 @@ pub struct RecordedPath {
 /// Progress of a render: (work done, total work), in tile-samples.
 pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
 
-/// Renders `scene` at `width` x `height` with `spp` samples per pixel.
+/// Renders `scene` at its image settings (size, samples per pixel, depth,
+/// filter, seed) with the shader `variant`.
 pub fn render(
     device: &Arc<Device>,
     cmds: &mut Commands,
     gpu: &GpuScene,
     scene: &Scene,
-    (width, height, spp): (u32, u32, u32),
     variant: RenderVariant,
     progress: Progress<'_>,
 ) -> Result<RenderOutput, RenderError> {
-    let mut renderer = Renderer::new(device, cmds, gpu, scene, (width, height, spp), variant)?;
-    renderer.add_samples(cmds, spp, progress)?;
+    let mut renderer = Renderer::new(device, cmds, gpu, scene, variant)?;
+    renderer.add_samples(cmds, scene.image.spp, progress)?;
     let mut out = renderer.output(cmds)?;
     renderer.read_caustic_statistics(&mut out);
     Ok(out)
@@ -215,22 +215,23 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Builds the passes `scene` needs for a `width` x `height` image (the
-    /// volume pass sized for `spp` samples per pixel), runs the caustic and
-    /// volume passes for the scene's camera, and clears the accumulation.
+    /// Builds the passes `scene` needs for an image of its size (the
+    /// footprints and the volume pass sized for its samples per pixel), runs
+    /// the caustic and volume passes for the scene's camera, and clears the
+    /// accumulation.
     pub fn new(
         device: &Arc<Device>,
         cmds: &mut Commands,
         gpu: &GpuScene,
         scene: &Scene,
-        (width, height, spp): (u32, u32, u32),
         variant: RenderVariant,
     ) -> Result<Self, RenderError> {
-        Self::with_bounds(device, cmds, gpu, scene, (width, height, spp), PixelBounds::full(width, height), variant)
+        let full = PixelBounds::full(scene.image.width, scene.image.height);
+        Self::with_bounds(device, cmds, gpu, scene, full, variant)
     }
 
     /// [`Renderer::new`] for the pixels of `bounds` alone (a crop or tile
-    /// of the `width` x `height` frame): samples are taken only there, with
+    /// of the scene's frame): samples are taken only there, with
     /// the same random numbers as in a render of the whole frame. The
     /// caustic and volume passes still cover the whole frame.
     pub fn with_bounds(
@@ -238,10 +239,10 @@ impl Renderer {
         cmds: &mut Commands,
         gpu: &GpuScene,
         scene: &Scene,
-        (width, height, spp): (u32, u32, u32),
         bounds: PixelBounds,
         variant: RenderVariant,
     ) -> Result<Self, RenderError> {
+        let (width, height, spp) = (scene.image.width, scene.image.height, scene.image.spp);
         let bounds = bounds.check(width, height)?;
         let pixels = width as u64 * height as u64;
         let frame = Buffer::with_data(

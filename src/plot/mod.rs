@@ -152,16 +152,8 @@ fn check_size((width, height): (u32, u32)) -> Result<(), PlotError> {
 }
 
 fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
-    let io_error = |source| PlotError::Io { path: path.to_path_buf(), source };
-    let name = path
-        .file_name()
-        .ok_or_else(|| io_error(std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path has no file name")))?;
-    let temporary = path.with_file_name(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
-    let result = std::fs::write(&temporary, bytes).and_then(|()| std::fs::rename(&temporary, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result.map_err(io_error)
+    crate::output::write_file_atomically(path, bytes)
+        .map_err(|source| PlotError::Io { path: path.to_path_buf(), source })
 }
 
 // ---------------------------------------------------------------------------

@@ -434,6 +434,14 @@ impl Light {
 }
 
 impl Scene {
+    /// A copy of the scene to render at `width` x `height` with `spp`
+    /// samples per pixel.
+    pub fn resized(&self, width: u32, height: u32, spp: u32) -> Self {
+        let mut s = self.clone();
+        (s.image.width, s.image.height, s.image.spp) = (width, height, spp);
+        s
+    }
+
     /// The scene at frame `frame` of its camera animation (the camera
     /// interpolated, [`Camera::at_frame`]); a copy of it for a still camera.
     pub fn at_frame(&self, frame: u32) -> Self {

@@ -353,8 +353,7 @@ impl App {
                 &g.device,
                 &mut g.cmds,
                 &g.scene_gpu,
-                &self.scene,
-                (im.width, im.height, target),
+                &self.scene.resized(im.width, im.height, target),
                 self.variant,
             )?);
             self.dirty.renderer = false;
