@@ -10,6 +10,7 @@ use clap::Parser;
 use quadray::output::{write_exr, ExrPrecision};
 use quadray::passes::{LookupMode, ShadingMode};
 use quadray::progress::ProgressBar;
+use quadray::scene::MAX_IMAGE_SIZE;
 use quadray::scene::{parse_scene, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
 #[derive(Parser, Debug)]
@@ -23,10 +24,10 @@ pub(crate) struct ThroughputArgs {
     #[arg(long)]
     pub(crate) baseline: Option<PathBuf>,
     /// Image width of the timed renders.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(8..=16384))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) width: u32,
     /// Image height of the timed renders.
-    #[arg(long, default_value_t = 768, value_parser = clap::value_parser!(u32).range(8..=16384))]
+    #[arg(long, default_value_t = 768, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) height: u32,
     /// Samples per pixel of the timed renders.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
@@ -55,10 +56,10 @@ pub(crate) struct BenchArgs {
     pub(crate) presets: Vec<Preset>,
     /// Image width of every render (the scenes' own sizes make the
     /// references slow on a CPU driver).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(8..=16384))]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) width: u32,
     /// Image height of every render.
-    #[arg(long, default_value_t = 192, value_parser = clap::value_parser!(u32).range(8..=16384))]
+    #[arg(long, default_value_t = 192, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) height: u32,
     /// Samples per pixel of the reference (default: the `reference` preset's 1024).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]

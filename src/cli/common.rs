@@ -6,16 +6,17 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use clap::Parser;
 use quadray::output::{ExrPrecision, OutputKind};
+use quadray::scene::MAX_IMAGE_SIZE;
 use quadray::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
 /// Image size and seed overrides of `render` and `outliers`.
 #[derive(Parser, Debug, Default, Clone)]
 pub(crate) struct FrameArgs {
     /// Image width in pixels (overrides `image.width`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) width: Option<u32>,
     /// Image height in pixels (overrides `image.height`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) height: Option<u32>,
     /// Random seed (overrides `image.seed`).
     #[arg(long)]

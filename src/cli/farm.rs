@@ -7,6 +7,7 @@ use super::images::*;
 use super::render::*;
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
+use quadray::scene::MAX_IMAGE_SIZE;
 
 /// `quadray farm`: Slurm job arrays of tiles and frames.
 #[derive(Subcommand, Debug)]
@@ -51,7 +52,7 @@ pub(crate) struct FarmSlurmArgs {
     /// Scene file (TOML, see scenes/README.md).
     pub(crate) scene: PathBuf,
     /// Tiles per frame (`render --tile i/N`: bands of whole rows).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) tiles: u32,
     /// Frames of the scene's camera animation, A-B or A-B:STEP; without it,
     /// the still camera.

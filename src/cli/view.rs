@@ -6,6 +6,7 @@ use super::common::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
 use quadray::scene::Preset;
+use quadray::scene::MAX_IMAGE_SIZE;
 
 #[cfg(feature = "viewer")]
 #[derive(Parser, Debug)]
@@ -21,10 +22,10 @@ pub(crate) struct ViewArgs {
     #[command(flatten)]
     pub(crate) quality: QualityArgs,
     /// Initial window width (overrides `image.width`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) width: Option<u32>,
     /// Initial window height (overrides `image.height`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) height: Option<u32>,
     /// Samples per pixel to accumulate before the view stops refining
     /// (default: the preset's or scene's spp).

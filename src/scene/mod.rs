@@ -9,7 +9,7 @@ use glam::{DAffine3, DVec2, DVec3, Vec3};
 
 use crate::geometry::FunctionalObject;
 
-pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME, MAX_IMAGE_SIZE};
 pub use preset::{FilterMode, Preset, Quality};
 
 /// A pinhole camera.

@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use crate::scene::Preset;
+use crate::scene::{Preset, MAX_IMAGE_SIZE};
 
 /// One thing the viewer does. Keys and script steps both become actions.
 #[derive(Clone, Debug, PartialEq)]
@@ -165,10 +165,10 @@ fn parse_step(s: &str) -> Result<Step, String> {
             let size = words.get(1).and_then(|w| w.split_once('x'));
             let parsed = size.and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)));
             match (parsed, words.len()) {
-                (Some((w, h)), 2) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => {
+                (Some((w, h)), 2) if (1..=MAX_IMAGE_SIZE).contains(&i64::from(w)) && (1..=MAX_IMAGE_SIZE).contains(&i64::from(h)) => {
                     Step::Do(Action::Resize(w, h))
                 }
-                _ => return Err("expects a size such as 320x240 (1 to 16384 each)".into()),
+                _ => return Err(format!("expects a size such as 320x240 (1 to {MAX_IMAGE_SIZE} each)")),
             }
         }
         "minimize" | "minimise" if words.len() == 1 => Step::Do(Action::Minimize(true)),
