@@ -2,7 +2,6 @@
 //! acceleration structure of procedural AABBs per object (one AABB per cell)
 //! and a top level with each object's transform.
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
@@ -14,10 +13,10 @@ use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Scene, TextureImage};
 use crate::shader_interface::{
     BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_MATERIALS, BINDING_OBJECTS,
-    BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES,
+    BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE,
 };
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
-use crate::texture::lean;
+use crate::texture::scene_maps;
 use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
 use crate::RenderError;
 
@@ -177,26 +176,6 @@ pub fn upload_texture(
     Ok(image)
 }
 
-/// What each texture of the scene holds: colour if every use of it is as an
-/// albedo map or the environment (both sRGB-decoded when read from PNG or
-/// JPEG), data otherwise.
-fn map_contents(scene: &Scene) -> Vec<MapContent> {
-    let mut color = vec![false; scene.textures.len()];
-    let mut data = vec![false; scene.textures.len()];
-    for m in &scene.materials {
-        if let Some(i) = m.maps.albedo {
-            color[i] = true;
-        }
-        for i in [m.maps.normal, m.maps.roughness, m.maps.displacement.map(|(i, _)| i)].into_iter().flatten() {
-            data[i] = true;
-        }
-    }
-    if let Some(e) = scene.environment {
-        color[e.texture] = true;
-    }
-    color.iter().zip(&data).map(|(&c, &d)| if c && !d { MapContent::Color } else { MapContent::Data }).collect()
-}
-
 /// Rounds a box outward to f32.
 fn f32_box(b: &Aabb) -> ([f32; 3], [f32; 3]) {
     let lo = b.min.to_array().map(|v| {
@@ -302,14 +281,27 @@ impl GpuScene {
             .collect();
         let tlas = AccelerationStructure::top_level(device, cmds, &instances)?;
 
-        let mut materials: Vec<GpuMaterial> = scene.materials.iter().map(GpuMaterial::from).collect();
-        let derived = derive_slope_moments(scene, &mut materials);
+        let moments = scene_maps::slope_moments(scene);
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let index = |t: Option<usize>| t.map_or(NO_TEXTURE, |t| t as u32);
+                GpuMaterial {
+                    normal_moments: index(moments.normal[i]),
+                    displacement_moments: index(moments.displacement[i]),
+                    ..GpuMaterial::from(m)
+                }
+            })
+            .collect();
+        let derived = moments.textures;
         let texture_count = scene.textures.len() + derived.len();
         if texture_count >= MAX_TEXTURES as usize {
             return Err(RenderError::TooManyTextures(texture_count));
         }
         let white = TextureImage { source: "white".into(), width: 1, height: 1, levels: vec![vec![[1.0; 4]]] };
-        let contents = map_contents(scene);
+        let contents = scene_maps::map_contents(scene);
         let mut textures = Vec::with_capacity(texture_count + 1);
         for (i, t) in scene.textures.iter().chain(&derived).chain([&white]).enumerate() {
             let content = contents.get(i).copied().unwrap_or(MapContent::Data);
@@ -398,31 +390,6 @@ impl GpuScene {
             (BINDING_CELL_LISTS, Binding::Buffer(&self.cell_lists)),
         ]
     }
-}
-
-/// The slope-moment textures of the scene's normal and displacement maps
-/// (one per distinct map, LEAN filtering: `texture::lean`), numbered after
-/// the scene's textures; sets the materials' `normal_moments` and
-/// `displacement_moments` indices.
-fn derive_slope_moments(scene: &Scene, materials: &mut [GpuMaterial]) -> Vec<TextureImage> {
-    let mut derived = Vec::new();
-    let mut index_of: HashMap<(bool, usize), u32> = HashMap::new();
-    let mut moments_of = |is_normal: bool, map: usize| {
-        *index_of.entry((is_normal, map)).or_insert_with(|| {
-            let t = &scene.textures[map];
-            derived.push(if is_normal { lean::normal_slope_moments(t) } else { lean::height_slope_moments(t) });
-            (scene.textures.len() + derived.len() - 1) as u32
-        })
-    };
-    for (m, g) in scene.materials.iter().zip(materials) {
-        if let Some(map) = m.maps.normal {
-            g.normal_moments = moments_of(true, map);
-        }
-        if let Some((map, _)) = m.maps.displacement {
-            g.displacement_moments = moments_of(false, map);
-        }
-    }
-    derived
 }
 
 /// The camera basis of a scene for an image of the given size.

@@ -44,6 +44,7 @@ pub mod encoding;
 pub mod lean;
 mod procedural;
 mod resample;
+pub mod scene_maps;
 
 use std::io;
 use std::path::{Path, PathBuf};
