@@ -20,29 +20,18 @@ use super::warp::frame_around;
 /// "PCG: A Family of Simple Fast Space-Efficient Statistically Good
 /// Algorithms for Random Number Generation", HMC-CS-2014-0905, 2014.
 #[derive(Clone, Debug)]
-pub struct Pcg32 {
-    state: u64,
-    inc: u64,
-}
+pub struct Pcg32(rand_pcg::Pcg32);
 
 impl Pcg32 {
-    const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
-
-    /// A generator on stream `stream` started from `seed`.
+    /// A generator on stream `stream` started from `seed` (the reference
+    /// implementation's `pcg32_srandom_r(seed, stream)`).
     pub fn new(seed: u64, stream: u64) -> Self {
-        let mut rng = Self { state: 0, inc: (stream << 1) | 1 };
-        rng.next_u32();
-        rng.state = rng.state.wrapping_add(seed);
-        rng.next_u32();
-        rng
+        Self(rand_pcg::Pcg32::new(seed, stream))
     }
 
     /// The next 32 random bits.
     pub fn next_u32(&mut self) -> u32 {
-        let old = self.state;
-        self.state = old.wrapping_mul(Self::MULTIPLIER).wrapping_add(self.inc);
-        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-        xorshifted.rotate_right((old >> 59) as u32)
+        rand_core::RngCore::next_u32(&mut self.0)
     }
 
     /// A uniform number in [0, 1) with 53 random bits.
@@ -370,77 +359,20 @@ pub fn chi2_p_value(chi2: f64, dof: usize) -> f64 {
     gamma_q(0.5 * dof as f64, 0.5 * chi2.max(0.0))
 }
 
-/// ln Γ(z) for z > 0: shifted up to z ≥ 15 by Γ(z) = Γ(z + 1)/z, then
-/// Stirling's series ln Γ(z) ≈ (z − ½) ln z − z + ½ ln 2π + Σ B₂ₖ / (2k (2k − 1) z^(2k−1)),
-/// k = 1..5 (B₂ = 1/6, B₄ = −1/30, B₆ = 1/42, B₈ = −1/30, B₁₀ = 5/66; Abramowitz &
-/// Stegun 6.1.40). Relative error below 1e-15 for z ≥ 15.
+/// ln Γ(z) for z > 0 (`statrs`).
 pub fn ln_gamma(z: f64) -> f64 {
     assert!(z > 0.0, "ln_gamma needs z > 0, got {z}");
-    let mut z = z;
-    let mut shift = 0.0;
-    while z < 15.0 {
-        shift += z.ln();
-        z += 1.0;
-    }
-    let zi = 1.0 / z;
-    let zi2 = zi * zi;
-    let series = zi * (1.0 / 12.0 + zi2 * (-1.0 / 360.0 + zi2 * (1.0 / 1260.0 + zi2 * (-1.0 / 1680.0 + zi2 / 1188.0))));
-    (z - 0.5) * z.ln() - z + 0.5 * (TAU).ln() + series - shift
+    statrs::function::gamma::ln_gamma(z)
 }
 
 /// The regularised upper incomplete gamma function
-/// Q(a, x) = Γ(a, x)/Γ(a) = 1 − P(a, x), a > 0, x ≥ 0.
-///
-/// For x < a + 1 from the power series
-/// P(a, x) = e^(−x) x^a / Γ(a) · Σₙ xⁿ / (a (a + 1) ⋯ (a + n)) (A&S 6.5.29);
-/// otherwise from Legendre's continued fraction
-/// Q(a, x) = e^(−x) x^a / Γ(a) · 1/(x + 1 − a − 1(1 − a)/(x + 3 − a − 2(2 − a)/(x + 5 − a − ⋯)))
-/// (A&S 6.5.31 in its even form), evaluated by the modified Lentz method
-/// (Thompson & Barnett, J. Comput. Phys. 64, 1986).
+/// Q(a, x) = Γ(a, x)/Γ(a) = 1 − P(a, x), a > 0, x ≥ 0 (`statrs`).
 pub fn gamma_q(a: f64, x: f64) -> f64 {
     assert!(a > 0.0 && x >= 0.0, "gamma_q needs a > 0 and x >= 0, got a = {a}, x = {x}");
     if x == 0.0 {
         return 1.0;
     }
-    let log_prefactor = -x + a * x.ln() - ln_gamma(a);
-    if x < a + 1.0 {
-        let mut term = 1.0 / a;
-        let mut sum = term;
-        let mut n = 1.0;
-        while term.abs() > sum.abs() * 1e-17 && n < 1e5 {
-            term *= x / (a + n);
-            sum += term;
-            n += 1.0;
-        }
-        1.0 - sum * log_prefactor.exp()
-    } else {
-        const TINY: f64 = 1e-300;
-        let mut b = x + 1.0 - a;
-        let mut c = 1.0 / TINY;
-        let mut d = 1.0 / b;
-        let mut h = d;
-        let mut i = 1.0;
-        while i < 1e5 {
-            let an = -i * (i - a);
-            b += 2.0;
-            d = an * d + b;
-            if d.abs() < TINY {
-                d = TINY;
-            }
-            c = b + an / c;
-            if c.abs() < TINY {
-                c = TINY;
-            }
-            d = 1.0 / d;
-            let delta = d * c;
-            h *= delta;
-            if (delta - 1.0).abs() < 1e-16 {
-                break;
-            }
-            i += 1.0;
-        }
-        h * log_prefactor.exp()
-    }
+    statrs::function::gamma::gamma_ur(a, x)
 }
 
 /// ∫ₐᵇ f by adaptive Simpson quadrature: a panel is split while
