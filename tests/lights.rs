@@ -82,12 +82,7 @@ fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) {
         Some(Light::Sphere { centre, radius, .. }) => Some((*centre, *radius)),
         _ => None,
     };
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let out = quadray::render_scene(&ctx, &scene, &mut |_, _| {}).unwrap();
-    common::assert_finite(&out);
-    drop(ctx);
-    common::assert_no_validation_errors(&counters);
+    let out = common::render_validated(&scene);
 
     let (w, h) = (out.width as usize, out.height as usize);
     let half = (0.5 * scene.camera.vfov_degrees).to_radians().tan();

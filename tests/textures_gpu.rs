@@ -74,12 +74,7 @@ fn colour_maps_follow_the_uv_mappings() {
     scene.image.width = 96;
     scene.image.height = 72;
 
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let out = quadray::render_scene(&ctx, &scene, &mut |_, _| {}).unwrap();
-    common::assert_finite(&out);
-    drop(ctx);
-    common::assert_no_validation_errors(&counters);
+    let out = common::render_validated(&scene);
 
     // Reconstruct each pixel-centre hit, find the object it lies on (F' ≈ 0),
     // and compare the albedo AOV with the checker colour there.

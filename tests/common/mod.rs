@@ -25,13 +25,7 @@ pub fn assert_no_validation_errors(counters: &Arc<ValidationCounters>) {
 /// Renders `scene` on a fresh validated context; fails on any validation
 /// error (counted after the device is gone) and on any NaN or Inf pixel.
 pub fn render_validated(scene: &Scene) -> quadray::passes::RenderOutput {
-    let ctx = context();
-    let counters = ctx.counters();
-    let out = quadray::render_scene(&ctx, scene, &mut |_, _| {}).unwrap();
-    drop(ctx);
-    assert_no_validation_errors(&counters);
-    assert_finite(&out);
-    out
+    render_variant_validated(scene, Default::default())
 }
 
 /// Renders `scene` with `variant` on a fresh validated context; the same
