@@ -174,7 +174,7 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
             let variant = RenderVariant::default();
             let im = &scene.image;
             // Untimed warm-up: compiles every pipeline this quality uses.
-            render(device, &mut cmds, &gpu, &scene.resized(8, 8, 1), variant, &mut |_, _| {})
+            crate::passes::Renderer::warm_up(device, &mut cmds, &gpu, scene, variant)
                 .map_err(|e| render_error(&s.name, e))?;
             let work = im.width as u64 * im.height as u64 * im.spp as u64;
             let start = Instant::now();

@@ -362,15 +362,14 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
     let gpu = GpuScene::for_render(device, &mut cmds, &scene)?;
     let im = &scene.image;
     let variant = RenderVariant { caustics: false, volume: false, ..Default::default() };
-    // Renders `spp` samples of `s` (this scene, perhaps with another seed).
-    let render = |cmds: &mut quadray::vk::Commands, s: &Scene, spp: u32| {
+    // Renders `s` (this scene, or its reference with another seed and spp).
+    let render = |cmds: &mut quadray::vk::Commands, s: &Scene| {
         let mut progress = ProgressBar::new(false);
-        let s = s.resized(im.width, im.height, spp);
-        let out = quadray::passes::render(device, cmds, &gpu, &s, variant, &mut |d, t| progress.update(d, t));
+        let out = quadray::passes::render(device, cmds, &gpu, s, variant, &mut |d, t| progress.update(d, t));
         progress.finish();
         out
     };
-    let out = render(&mut cmds, &scene, im.spp)?;
+    let out = render(&mut cmds, &scene)?;
     let samples = out.width as u64 * out.height as u64 * out.spp as u64;
     let found = outliers(&out, bound);
     if let Some(m) = largest_sample(&out) {
@@ -385,7 +384,7 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
     }
     if !found.is_empty() && args.worst > 0 {
         let record = RenderVariant { record_path: true, ..variant };
-        let mut recorder = Renderer::new(device, &mut cmds, &gpu, &scene.resized(im.width, im.height, 1), record)?;
+        let mut recorder = Renderer::with_samples(device, &mut cmds, &gpu, &scene, 1, record)?;
         for o in found.iter().take(args.worst) {
             let path = recorder.trace_path(&mut cmds, (o.x, o.y), o.sample)?;
             println!("\npixel ({}, {}), sample {} (luminance {:.4}):", o.x, o.y, o.sample, o.luminance);
@@ -398,7 +397,8 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
     if let Some(reference_spp) = args.regions {
         let mut reference_scene = scene.clone();
         reference_scene.image.seed = scene.image.seed ^ 0x9e37_79b9;
-        let reference = render(&mut cmds, &reference_scene, reference_spp)?;
+        reference_scene.image.spp = reference_spp;
+        let reference = render(&mut cmds, &reference_scene)?;
         let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
         let e = quadray::metrics::region_relative_mse(&reference, &out, 2, 64)?;
         println!("\nrelative MSE at {} spp against {reference_spp} spp:", out.spp);

@@ -354,7 +354,7 @@ pub(crate) fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray
     let mut rows = Vec::new();
     for (name, variant) in variants {
         // Untimed warm-up: the shader variant compiles at its first dispatch.
-        render(device, &mut cmds, &gpu, &scene.resized(8, 8, 1), variant, &mut |_, _| {})?;
+        quadray::passes::Renderer::warm_up(device, &mut cmds, &gpu, scene, variant)?;
         let out = render(device, &mut cmds, &gpu, scene, variant, &mut |_, _| {})?;
         let samples = im.width as f64 * im.height as f64 * im.spp as f64;
         rows.push((name, out.seconds, samples / out.seconds));

@@ -66,9 +66,11 @@ impl Bench<'_> {
     /// variant (it does so at the first dispatch) before the timed renders.
     pub(super) fn warm_up(&mut self, filter: FilterMode) -> Result<(), BenchError> {
         let variant = self.variant();
-        let mut scene = self.scene.resized(8, 8, 1);
-        scene.image.filter = filter;
-        render(&self.ctx.device, &mut self.cmds, &self.gpu, &scene, variant, &mut |_, _| {})?;
+        let previous = std::mem::replace(&mut self.scene.image.filter, filter);
+        let warmed =
+            crate::passes::Renderer::warm_up(&self.ctx.device, &mut self.cmds, &self.gpu, &self.scene, variant);
+        self.scene.image.filter = previous;
+        warmed?;
         Ok(())
     }
 }

@@ -242,7 +242,48 @@ impl Renderer {
         bounds: PixelBounds,
         variant: RenderVariant,
     ) -> Result<Self, RenderError> {
-        let (width, height, spp) = (scene.image.width, scene.image.height, scene.image.spp);
+        let im = &scene.image;
+        Self::build(device, cmds, gpu, scene, (im.width, im.height, im.spp), bounds, variant)
+    }
+
+    /// [`Renderer::new`] for a view that accumulates `spp` samples per
+    /// pixel in place of the scene's (the viewer's target).
+    pub fn with_samples(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        gpu: &GpuScene,
+        scene: &Scene,
+        spp: u32,
+        variant: RenderVariant,
+    ) -> Result<Self, RenderError> {
+        let (width, height) = (scene.image.width, scene.image.height);
+        Self::build(device, cmds, gpu, scene, (width, height, spp), PixelBounds::full(width, height), variant)
+    }
+
+    /// Renders one sample of an 8x8 image of `scene` with `variant` and
+    /// drops it: lavapipe compiles each pipeline at its first dispatch, so
+    /// timed renders warm up first (without copying the scene, whose maps
+    /// may be large).
+    pub fn warm_up(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        gpu: &GpuScene,
+        scene: &Scene,
+        variant: RenderVariant,
+    ) -> Result<(), RenderError> {
+        let mut r = Self::build(device, cmds, gpu, scene, (8, 8, 1), PixelBounds::full(8, 8), variant)?;
+        r.add_samples(cmds, 1, &mut |_, _| {})
+    }
+
+    fn build(
+        device: &Arc<Device>,
+        cmds: &mut Commands,
+        gpu: &GpuScene,
+        scene: &Scene,
+        (width, height, spp): (u32, u32, u32),
+        bounds: PixelBounds,
+        variant: RenderVariant,
+    ) -> Result<Self, RenderError> {
         let bounds = bounds.check(width, height)?;
         let pixels = width as u64 * height as u64;
         let frame = Buffer::with_data(

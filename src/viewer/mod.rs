@@ -347,15 +347,9 @@ impl App {
         self.camera.apply(&mut self.scene.camera);
         let start = Instant::now();
         if self.dirty.renderer || g.renderer.is_none() {
-            let im = &self.scene.image;
             g.renderer = None;
-            g.renderer = Some(Renderer::new(
-                &g.device,
-                &mut g.cmds,
-                &g.scene_gpu,
-                &self.scene.resized(im.width, im.height, target),
-                self.variant,
-            )?);
+            g.renderer =
+                Some(Renderer::with_samples(&g.device, &mut g.cmds, &g.scene_gpu, &self.scene, target, self.variant)?);
             self.dirty.renderer = false;
             self.dirty.camera = false;
             self.shown = None;
