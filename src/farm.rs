@@ -380,36 +380,58 @@ impl Farm {
         if missing.is_empty() && self.unmerged_frames().is_empty() {
             return Ok(None);
         }
-        let logs = self.dir.join("logs");
-        let name = format!("quadray-{}", self.manifest.name);
-        let common = |cmd: &mut Command| {
-            cmd.arg("--parsable")
-                .arg(format!("--job-name={name}"))
-                .arg(format!("--cpus-per-task={}", self.manifest.cpus_per_task))
-                .arg(format!("--chdir={}", self.dir.display()))
-                .args(&self.manifest.sbatch_args);
-        };
-        let array_job = if missing.is_empty() {
-            String::new()
-        } else {
-            let mut cmd = Command::new("sbatch");
-            common(&mut cmd);
-            cmd.arg(format!("--array={}", array_spec(&missing)))
-                .arg(format!("--output={}", logs.join("task-%A_%a.log").display()))
-                .arg(self.dir.join("task.sh"));
-            run_slurm(&mut cmd)?
-        };
-        let mut cmd = Command::new("sbatch");
-        common(&mut cmd);
-        if !array_job.is_empty() {
-            cmd.arg(format!("--dependency=afterok:{array_job}")).arg("--kill-on-invalid-dep=yes");
-        }
-        cmd.arg(format!("--output={}", logs.join("merge-%j.log").display())).arg(self.dir.join("merge.sh"));
-        let merge_job = run_slurm(&mut cmd)?;
+        let array_job = if missing.is_empty() { String::new() } else { run_slurm(&mut self.array_command(&missing))? };
+        let merge_job = run_slurm(&mut self.merge_command(Some(array_job.as_str()).filter(|a| !a.is_empty())))?;
         let submission = Submission { array_job, tasks: missing, merge_job };
         self.manifest.submissions.push(submission.clone());
         self.save()?;
         Ok(Some(submission))
+    }
+
+    /// What [`Farm::submit`] would run now, as command lines (the merge
+    /// job's dependency names the array job as `<array job>`), without
+    /// asking Slurm anything; empty when there is nothing to submit.
+    pub fn plan(&self) -> Vec<String> {
+        let missing: Vec<u32> = self.missing_tasks().iter().map(|t| t.index).collect();
+        if missing.is_empty() && self.unmerged_frames().is_empty() {
+            return Vec::new();
+        }
+        let mut lines = Vec::new();
+        if !missing.is_empty() {
+            lines.push(command_line(&self.array_command(&missing)));
+        }
+        lines.push(command_line(&self.merge_command((!missing.is_empty()).then_some("<array job>"))));
+        lines
+    }
+
+    /// An `sbatch` command with the options of every submission.
+    fn sbatch(&self) -> Command {
+        let mut cmd = Command::new("sbatch");
+        cmd.arg("--parsable")
+            .arg(format!("--job-name=quadray-{}", self.manifest.name))
+            .arg(format!("--cpus-per-task={}", self.manifest.cpus_per_task))
+            .arg(format!("--chdir={}", self.dir.display()))
+            .args(&self.manifest.sbatch_args);
+        cmd
+    }
+
+    /// The job array of the tasks `missing`.
+    fn array_command(&self, missing: &[u32]) -> Command {
+        let mut cmd = self.sbatch();
+        cmd.arg(format!("--array={}", array_spec(missing)))
+            .arg(format!("--output={}", self.dir.join("logs/task-%A_%a.log").display()))
+            .arg(self.dir.join("task.sh"));
+        cmd
+    }
+
+    /// The merge job, after `array_job` when there is one.
+    fn merge_command(&self, array_job: Option<&str>) -> Command {
+        let mut cmd = self.sbatch();
+        if let Some(job) = array_job {
+            cmd.arg(format!("--dependency=afterok:{job}")).arg("--kill-on-invalid-dep=yes");
+        }
+        cmd.arg(format!("--output={}", self.dir.join("logs/merge-%j.log").display())).arg(self.dir.join("merge.sh"));
+        cmd
     }
 
     /// The jobs of this farm's submissions that `squeue` still lists.
@@ -479,6 +501,19 @@ impl WithExr for PathBuf {
         s.push(".exr");
         PathBuf::from(s)
     }
+}
+
+/// A command as one line, its arguments quoted for `sh` where needed.
+fn command_line(cmd: &Command) -> String {
+    let quote = |s: &std::ffi::OsStr| {
+        let s = s.to_string_lossy();
+        if s.chars().all(|c| c.is_ascii_alphanumeric() || "-_=./:%,".contains(c)) {
+            s.into_owned()
+        } else {
+            shell_quote(&s)
+        }
+    };
+    std::iter::once(cmd.get_program()).chain(cmd.get_args()).map(quote).collect::<Vec<_>>().join(" ")
 }
 
 /// Runs a Slurm command and returns its standard output (trimmed; for
@@ -592,6 +627,18 @@ mod tests {
         other.tiles = 2;
         assert!(matches!(Farm::create(dir.path(), other), Err(FarmError::Exists(_))));
         assert_eq!(Farm::open(dir.path()).unwrap().manifest, farm.manifest);
+    }
+
+    #[test]
+    fn a_plan_lists_the_array_and_the_merge_job_without_slurm() {
+        let dir = tempfile::tempdir().unwrap();
+        let farm = Farm::create(dir.path(), manifest(Some(vec![3, 5]))).unwrap();
+        let plan = farm.plan();
+        assert_eq!(plan.len(), 2, "{plan:?}");
+        assert!(plan[0].starts_with("sbatch --parsable --job-name=quadray-move --cpus-per-task=1"), "{}", plan[0]);
+        assert!(plan[0].contains(" --array=0-7 ") && plan[0].ends_with("task.sh"), "{}", plan[0]);
+        assert!(plan[1].contains("'--dependency=afterok:<array job>' --kill-on-invalid-dep=yes"), "{}", plan[1]);
+        assert!(plan[1].ends_with("merge.sh"), "{}", plan[1]);
     }
 
     #[test]

@@ -416,4 +416,18 @@ fn bad_farm_settings_are_clear_errors_that_write_nothing() {
     let farm = quadray::farm::Farm::open(&tmp.path().join("f")).unwrap();
     assert_eq!((farm.manifest.tiles, farm.manifest.frames.clone()), (2, Some(vec![0, 1])));
     assert!(farm.manifest.submissions.is_empty());
+    // A dry run needs no Slurm: it prints what it would submit.
+    let out = Command::new(env!("CARGO_BIN_EXE_quadray"))
+        .args(["farm", "resume", "f", "--dry-run"])
+        .current_dir(tmp.path())
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    assert!(lines[0].starts_with("sbatch ") && lines[0].contains("--array=0-3"), "{stdout}");
+    assert!(lines[1].contains("--dependency=afterok:<array job>") && lines[1].ends_with("merge.sh"), "{stdout}");
+    assert!(quadray::farm::Farm::open(&tmp.path().join("f")).unwrap().manifest.submissions.is_empty());
 }

@@ -22,6 +22,9 @@ pub(crate) enum FarmCommand {
     Resume {
         /// The farm folder.
         dir: PathBuf,
+        /// Print the sbatch commands instead of running them.
+        #[arg(long)]
+        dry_run: bool,
     },
     /// Print a farm's progress: per frame, the tiles done and checkpointed,
     /// and whether it is merged.
@@ -72,6 +75,10 @@ pub(crate) struct FarmSlurmArgs {
     /// `--sbatch-arg=--partition=render` (repeatable).
     #[arg(long = "sbatch-arg", allow_hyphen_values = true)]
     pub(crate) sbatch_args: Vec<String>,
+    /// Set up the farm folder and print the sbatch commands instead of
+    /// running them (needs no Slurm).
+    #[arg(long)]
+    pub(crate) dry_run: bool,
     /// `quadray render` flags of every task, after `--`: quality, size,
     /// seed (e.g. `-- --spp 256 --width 1920 --height 1080`).
     #[arg(last = true)]
@@ -118,9 +125,9 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
                 submissions: Vec::new(),
             };
             let mut farm = Farm::create(&args.output, manifest)?;
-            farm_submit(&mut farm)
+            farm_submit(&mut farm, args.dry_run)
         }
-        FarmCommand::Resume { dir } => farm_submit(&mut Farm::open(&dir)?),
+        FarmCommand::Resume { dir, dry_run } => farm_submit(&mut Farm::open(&dir)?, dry_run),
         FarmCommand::Status { dir } => {
             print!("{}", Farm::open(&dir)?.status());
             Ok(())
@@ -179,7 +186,17 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
 }
 
 /// Submits what a farm lacks and says what was submitted.
-pub(crate) fn farm_submit(farm: &mut quadray::farm::Farm) -> Result<()> {
+pub(crate) fn farm_submit(farm: &mut quadray::farm::Farm, dry_run: bool) -> Result<()> {
+    if dry_run {
+        let plan = farm.plan();
+        if plan.is_empty() {
+            eprintln!("farm {}: every tile is rendered and every frame merged; nothing to submit", farm.dir.display());
+        }
+        for line in plan {
+            println!("{line}");
+        }
+        return Ok(());
+    }
     match farm.submit()? {
         None => {
             eprintln!("farm {}: every tile is rendered and every frame merged; nothing to submit", farm.dir.display())
