@@ -165,9 +165,16 @@ impl Manifest {
         self.frames.as_ref().map_or(vec![None], |f| f.iter().copied().map(Some).collect())
     }
 
-    fn tile_file_name(&self, task: Task) -> String {
-        let frame = task.frame.map_or(String::new(), |f| format!(".{f:04}"));
-        format!("{}.tile-{}-of-{}{frame}.exr", self.name, task.tile, self.tiles)
+    /// A task's `-o` name, `NAME.tile-I-of-N.exr`, without the frame number.
+    fn tile_base_name(&self, task: Task) -> PathBuf {
+        PathBuf::from(format!("{}.tile-{}-of-{}.exr", self.name, task.tile, self.tiles))
+    }
+
+    /// The name of the file a task's render writes: its `-o` name with the
+    /// frame number `render --frame` adds.
+    fn tile_file_name(&self, task: Task) -> PathBuf {
+        let base = self.tile_base_name(task);
+        task.frame.map_or_else(|| base.clone(), |f| crate::output::frame_path(&base, f))
     }
 
     /// The `quadray render` arguments of a task (after `render`), writing to
@@ -211,6 +218,18 @@ pub const FARM_OWNED_FLAGS: [&str; 11] = [
     "-o",
 ];
 
+/// Refuses render flags that the farm sets itself for each task
+/// ([`FARM_OWNED_FLAGS`], alone or as `--flag=value`).
+pub fn check_render_args(render_args: &[String]) -> Result<(), FarmError> {
+    match render_args.iter().find(|a| FARM_OWNED_FLAGS.contains(&a.split('=').next().unwrap_or_default())) {
+        Some(flag) => Err(FarmError::Invalid(format!(
+            "{flag} is set by the farm for each task; give it to `quadray farm slurm` (tiles, frames, \
+             checkpoints) or leave it out"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// A farm folder and its manifest.
 #[derive(Debug, Clone)]
 pub struct Farm {
@@ -229,16 +248,7 @@ impl Farm {
         if manifest.tiles == 0 {
             return Err(FarmError::Invalid("a farm needs at least one tile per frame".into()));
         }
-        if let Some(flag) = manifest
-            .render_args
-            .iter()
-            .find(|a| FARM_OWNED_FLAGS.iter().any(|f| a.as_str() == *f || a.starts_with(&format!("{f}="))))
-        {
-            return Err(FarmError::Invalid(format!(
-                "{flag} is set by the farm for each task; give it to `quadray farm slurm` (tiles, frames, \
-                 checkpoints) or leave it out"
-            )));
-        }
+        check_render_args(&manifest.render_args)?;
         std::fs::create_dir_all(dir).map_err(io(dir))?;
         let dir = std::fs::canonicalize(dir).map_err(io(dir))?;
         let path = dir.join("farm.json");
@@ -309,23 +319,28 @@ impl Farm {
     /// The `-o` of a task's render (in `tiles/partial/`, without the frame
     /// number) and the file it writes.
     pub fn partial_paths(&self, task: Task) -> (PathBuf, PathBuf) {
-        let base = self
-            .dir
-            .join("tiles/partial")
-            .join(format!("{}.tile-{}-of-{}.exr", self.manifest.name, task.tile, self.manifest.tiles));
-        let written = self.dir.join("tiles/partial").join(self.manifest.tile_file_name(task));
-        (base, written)
+        let partial = self.dir.join("tiles/partial");
+        (partial.join(self.manifest.tile_base_name(task)), partial.join(self.manifest.tile_file_name(task)))
     }
 
     /// A task's checkpoint.
     pub fn checkpoint_path(&self, task: Task) -> PathBuf {
-        self.dir.join("checkpoints").join(self.manifest.tile_file_name(task).replace(".exr", ".ckpt"))
+        self.dir.join("checkpoints").join(self.manifest.tile_file_name(task).with_extension("ckpt"))
     }
 
     /// A merged frame's output name (without extension: PNG and EXR).
     pub fn frame_output(&self, frame: Option<u32>) -> PathBuf {
+        // Not output::frame_path: a scene name may hold dots ("a.b"), which
+        // that would read as an extension.
         let frame = frame.map_or(String::new(), |f| format!(".{f:04}"));
         self.dir.join(format!("{}{frame}", self.manifest.name))
+    }
+
+    /// Whether a frame is merged (its EXR is there).
+    fn merged(&self, frame: Option<u32>) -> bool {
+        let mut exr = self.frame_output(frame).into_os_string();
+        exr.push(".exr");
+        PathBuf::from(exr).exists()
     }
 
     /// The tasks whose tiles are not in `tiles/`.
@@ -335,11 +350,7 @@ impl Farm {
 
     /// The frames not merged yet (their EXR is missing).
     pub fn unmerged_frames(&self) -> Vec<Option<u32>> {
-        self.manifest
-            .frame_list()
-            .into_iter()
-            .filter(|f| !self.frame_output(*f).with_extension_exr().exists())
-            .collect()
+        self.manifest.frame_list().into_iter().filter(|f| !self.merged(*f)).collect()
     }
 
     /// Appends a line to `journal.log` (one `write`, so lines of concurrent
@@ -376,10 +387,7 @@ impl Farm {
         if !active.is_empty() {
             return Err(FarmError::Busy(active.join(", ")));
         }
-        let missing: Vec<u32> = self.missing_tasks().iter().map(|t| t.index).collect();
-        if missing.is_empty() && self.unmerged_frames().is_empty() {
-            return Ok(None);
-        }
+        let Some(missing) = self.pending() else { return Ok(None) };
         let array_job = if missing.is_empty() { String::new() } else { run_slurm(&mut self.array_command(&missing))? };
         let merge_job = run_slurm(&mut self.merge_command(Some(array_job.as_str()).filter(|a| !a.is_empty())))?;
         let submission = Submission { array_job, tasks: missing, merge_job };
@@ -392,16 +400,20 @@ impl Farm {
     /// job's dependency names the array job as `<array job>`), without
     /// asking Slurm anything; empty when there is nothing to submit.
     pub fn plan(&self) -> Vec<String> {
-        let missing: Vec<u32> = self.missing_tasks().iter().map(|t| t.index).collect();
-        if missing.is_empty() && self.unmerged_frames().is_empty() {
-            return Vec::new();
-        }
+        let Some(missing) = self.pending() else { return Vec::new() };
         let mut lines = Vec::new();
         if !missing.is_empty() {
             lines.push(command_line(&self.array_command(&missing)));
         }
         lines.push(command_line(&self.merge_command((!missing.is_empty()).then_some("<array job>"))));
         lines
+    }
+
+    /// The task numbers a submission renders now (empty when only the merge
+    /// is left), or `None` when every tile is there and every frame merged.
+    fn pending(&self) -> Option<Vec<u32>> {
+        let missing: Vec<u32> = self.missing_tasks().iter().map(|t| t.index).collect();
+        (!missing.is_empty() || !self.unmerged_frames().is_empty()).then_some(missing)
     }
 
     /// An `sbatch` command with the options of every submission.
@@ -467,39 +479,22 @@ impl Farm {
             m.submissions.len()
         );
         for frame in m.frame_list() {
-            let tasks = m.frame_tasks(frame);
-            let done: Vec<u32> = tasks.iter().filter(|t| self.tile_path(**t).exists()).map(|t| t.tile).collect();
-            let ckpt: Vec<u32> = tasks
-                .iter()
-                .filter(|t| !self.tile_path(**t).exists() && self.checkpoint_path(**t).exists())
-                .map(|t| t.tile)
-                .collect();
-            let merged = self.frame_output(frame).with_extension_exr().exists();
+            let state: Vec<(u32, Option<bool>)> =
+                m.frame_tasks(frame).into_iter().map(|t| (t.tile, self.prepare_task(t))).collect();
+            let done = state.iter().filter(|s| s.1.is_none()).count();
+            let ckpt: Vec<u32> = state.iter().filter(|s| s.1 == Some(true)).map(|s| s.0).collect();
+            let merged = self.merged(frame);
             let _ = writeln!(
                 s,
                 "  {}: {}/{} tiles done{}{}",
                 frame.map_or("still".to_string(), |f| format!("frame {f}")),
-                done.len(),
+                done,
                 m.tiles,
                 if ckpt.is_empty() { String::new() } else { format!(", tiles {ckpt:?} checkpointed") },
                 if merged { ", merged" } else { "" }
             );
         }
         s
-    }
-}
-
-trait WithExr {
-    fn with_extension_exr(&self) -> PathBuf;
-}
-
-impl WithExr for PathBuf {
-    /// `NAME.0002` → `NAME.0002.exr` (appends, where `with_extension` would
-    /// replace the frame number).
-    fn with_extension_exr(&self) -> PathBuf {
-        let mut s = self.clone().into_os_string();
-        s.push(".exr");
-        PathBuf::from(s)
     }
 }
 
@@ -519,7 +514,7 @@ fn command_line(cmd: &Command) -> String {
 /// Runs a Slurm command and returns its standard output (trimmed; for
 /// `sbatch --parsable`, the job id before any `;cluster`).
 fn run_slurm(cmd: &mut Command) -> Result<String, FarmError> {
-    let line = format!("{cmd:?}").replace('"', "");
+    let line = command_line(cmd);
     let out = cmd.output().map_err(|e| FarmError::Slurm {
         command: line.clone(),
         why: format!("{e} (is Slurm installed and on PATH? `make setup` installs slurm-client)"),

@@ -49,6 +49,17 @@ fn temporary_path(path: &Path) -> io::Result<PathBuf> {
     Ok(path.with_file_name(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id())))
 }
 
+/// `path` with the frame number before its extension: `out.exr` →
+/// `out.0002.exr`, `out` → `out.0002` (the names of `render --frame`).
+pub fn frame_path(path: &Path, frame: u32) -> PathBuf {
+    let stem = path.file_stem().map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    let name = match path.extension() {
+        Some(e) => format!("{stem}.{frame:04}.{}", e.to_string_lossy()),
+        None => format!("{stem}.{frame:04}"),
+    };
+    path.with_file_name(name)
+}
+
 /// Writes several files all or nothing: `write(i, tmp)` fills a temporary
 /// file beside `paths[i]`, and only when all are written are they renamed
 /// into place. On error every temporary file is removed, and the error names

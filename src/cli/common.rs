@@ -31,6 +31,13 @@ pub(crate) struct FrameRange {
     pub(crate) step: u32,
 }
 
+impl FrameRange {
+    /// The frames of the range, in order.
+    pub(crate) fn frames(self) -> Vec<u32> {
+        (self.first..=self.last).step_by(self.step as usize).collect()
+    }
+}
+
 impl std::str::FromStr for FrameRange {
     type Err = String;
 

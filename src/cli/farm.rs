@@ -92,7 +92,10 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
         FarmCommand::Slurm(args) => {
             let scene =
                 std::fs::canonicalize(&args.scene).with_context(|| format!("scene file {}", args.scene.display()))?;
-            let frames: Option<Vec<u32>> = args.frames.map(|r| (r.first..=r.last).step_by(r.step as usize).collect());
+            let frames = args.frames.map(FrameRange::frames);
+            // Flags the farm sets itself would otherwise meet clap's "used
+            // more than once" below.
+            quadray::farm::check_render_args(&args.render_args)?;
             // The tasks' render command, checked here (flags, scene, tiles)
             // rather than in every task.
             let mut check = vec!["quadray".to_string(), "render".into(), scene.display().to_string()];
@@ -100,10 +103,6 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
             check.extend(["--tile".into(), format!("0/{}", args.tiles)]);
             if let Some(f) = frames.as_ref() {
                 check.extend(["--frame".into(), f[0].to_string()]);
-            }
-            let owned = quadray::farm::FARM_OWNED_FLAGS;
-            if let Some(flag) = args.render_args.iter().find(|a| owned.iter().any(|f| a.split('=').next() == Some(f))) {
-                bail!("{flag} is set by the farm for each task; leave it out of the render flags");
             }
             let render_args = RenderArgs::try_parse_from(&check[1..])?;
             let loaded = load(&render_args)?;
@@ -187,10 +186,13 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
 
 /// Submits what a farm lacks and says what was submitted.
 pub(crate) fn farm_submit(farm: &mut quadray::farm::Farm, dry_run: bool) -> Result<()> {
+    let nothing = |farm: &quadray::farm::Farm| {
+        eprintln!("farm {}: every tile is rendered and every frame merged; nothing to submit", farm.dir.display())
+    };
     if dry_run {
         let plan = farm.plan();
         if plan.is_empty() {
-            eprintln!("farm {}: every tile is rendered and every frame merged; nothing to submit", farm.dir.display());
+            nothing(farm);
         }
         for line in plan {
             println!("{line}");
@@ -198,9 +200,7 @@ pub(crate) fn farm_submit(farm: &mut quadray::farm::Farm, dry_run: bool) -> Resu
         return Ok(());
     }
     match farm.submit()? {
-        None => {
-            eprintln!("farm {}: every tile is rendered and every frame merged; nothing to submit", farm.dir.display())
-        }
+        None => nothing(farm),
         Some(s) => {
             if s.array_job.is_empty() {
                 eprintln!("every tile is there: submitted merge job {}", s.merge_job);

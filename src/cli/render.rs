@@ -1,7 +1,7 @@
 //! `quadray render`: a scene to PNG and EXR, with checkpoints, crops, tiles
 //! and frames, and its `--bench` mode.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::common::*;
 use anyhow::{bail, Context as _, Result};
@@ -105,20 +105,9 @@ pub(crate) fn load(args: &RenderArgs) -> Result<Scene> {
 pub(crate) fn requested_frames(args: &RenderArgs) -> Option<Vec<u32>> {
     match (args.animation_frame, args.frames) {
         (Some(f), _) => Some(vec![f]),
-        (None, Some(r)) => Some((r.first..=r.last).step_by(r.step as usize).collect()),
+        (None, Some(r)) => Some(r.frames()),
         (None, None) => None,
     }
-}
-
-/// `path` with the frame number before its extension: `out.exr` →
-/// `out.0002.exr`.
-pub(crate) fn frame_path(path: &Path, frame: u32) -> PathBuf {
-    let stem = path.file_stem().map_or(String::new(), |s| s.to_string_lossy().into_owned());
-    let name = match path.extension() {
-        Some(e) => format!("{stem}.{frame:04}.{}", e.to_string_lossy()),
-        None => format!("{stem}.{frame:04}"),
-    };
-    path.with_file_name(name)
 }
 
 pub(crate) fn render(args: RenderArgs) -> Result<()> {
@@ -200,7 +189,7 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
                 eprintln!("resumed at {} of {} spp", result.resumed_from, frame_scene.image.spp);
             }
             let paths: Vec<PathBuf> = match frame {
-                Some(f) => outputs.iter().map(|p| frame_path(p, f)).collect(),
+                Some(f) => outputs.iter().map(|p| quadray::output::frame_path(p, f)).collect(),
                 None => outputs.clone(),
             };
             write_render(&args, &ctx, &frame_scene, variant, &paths, frame, &result.output, result.end)?;

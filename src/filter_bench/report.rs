@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use crate::output::write_all_or_nothing;
+use crate::output::{write_all_or_nothing, write_file_atomically};
 use crate::plot::{write_log_log_plot, HLine, Series};
 
 use super::*;
@@ -162,7 +162,7 @@ pub struct ReferenceInfo {
     pub seed: u32,
     /// Camera offset along its right vector (temporal frames), scene units.
     pub camera_offset: f64,
-    /// The shading variant (`SHADING_*`).
+    /// The shading variant (`ShadingMode::constant`, the shader's `SHADING_*`).
     #[serde(default)]
     pub shading: u32,
     /// The pixel filter's σ (0 in caches made with the old box filter).
@@ -186,16 +186,14 @@ impl ReferenceInfo {
 pub(super) fn write_summaries(config: &Config, reports: &[SceneReport]) -> Result<(), BenchError> {
     let summary = config.out_dir.join("summary.md");
     let text = summary_markdown(config, reports);
-    write_all_or_nothing(std::slice::from_ref(&summary), |_, p| std::fs::write(p, &text))
-        .map_err(io_error(&summary))?;
+    write_file_atomically(&summary, text.as_bytes()).map_err(io_error(&summary))?;
     let headline_path = config.out_dir.join("headline.json");
     let mut entries: Vec<HeadlineEntry> =
         std::fs::read_to_string(&headline_path).ok().and_then(|t| serde_json::from_str(&t).ok()).unwrap_or_default();
     entries.retain(|e| !reports.iter().any(|r| r.scene == e.scene));
     entries.extend(reports.iter().flat_map(headline_entries));
     let json = serde_json::to_string_pretty(&entries).expect("serialisable");
-    write_all_or_nothing(std::slice::from_ref(&headline_path), |_, p| std::fs::write(p, &json))
-        .map_err(io_error(&headline_path))?;
+    write_file_atomically(&headline_path, json.as_bytes()).map_err(io_error(&headline_path))?;
     eprintln!("wrote {} and {}", summary.display(), headline_path.display());
     Ok(())
 }

@@ -231,7 +231,7 @@ impl Checkpoint {
     /// place): a render killed while writing leaves the previous one.
     pub fn write(&self, path: &Path) -> Result<(), CheckpointError> {
         let bytes = self.to_bytes();
-        crate::output::write_all_or_nothing(&[path.to_path_buf()], |_, tmp| std::fs::write(tmp, &bytes))
+        crate::output::write_file_atomically(path, &bytes)
             .map_err(|source| CheckpointError::Io { path: path.into(), source })
     }
 

@@ -25,8 +25,8 @@ pub struct ProbePass {
 }
 
 impl ProbePass {
-    /// Uploads `rays` and binds them with the scene; `mode` is one of the
-    /// `INTERSECT_*` constants (`IntersectMode::Full` for the real intersection);
+    /// Uploads `rays` and binds them with the scene; `mode` is how candidate
+    /// boxes are intersected (`IntersectMode::Full` for the real intersection);
     /// `curvature` asks for the hits' curvatures (zero otherwise).
     pub fn new(
         device: &Arc<Device>,

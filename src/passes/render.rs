@@ -314,8 +314,7 @@ impl Renderer {
         )?;
         let aov =
             Buffer::storage(device, "aov", pixels * std::mem::size_of::<GpuAov>() as u64, MemoryLocation::GpuToCpu)?;
-        // The recorded path: a count, then the vertices (std430/scalar: the
-        // array starts at offset 4).
+        // The recorded path (`GpuPathRecord`): a count, then the vertices.
         let path_bytes = std::mem::size_of::<GpuPathRecord>() as u64;
         let path = Buffer::storage(device, "recorded path", path_bytes, MemoryLocation::GpuToCpu)?;
         let pipeline = render_pipeline(device, gpu, scene, variant, caustics.as_ref(), volume.is_some())?;

@@ -177,9 +177,8 @@ impl ComputePipeline {
     /// shader does not declare are left out (passes share the scene's).
     pub fn bind(&self, resources: &[(u32, Binding<'_>)]) -> Result<(), VkError> {
         let kinds: Vec<(u32, BindingKind)> = resources.iter().map(|(n, r)| (*n, r.kind())).collect();
-        self.interface.check_bindings(&kinds)?;
-        let resources: Vec<&(u32, Binding<'_>)> =
-            resources.iter().filter(|(n, _)| self.interface.bindings.contains_key(n)).collect();
+        let unused = self.interface.check_bindings(&kinds)?;
+        let resources: Vec<&(u32, Binding<'_>)> = resources.iter().filter(|(n, _)| !unused.contains(n)).collect();
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
         let mut as_handles = Vec::new();
