@@ -1,7 +1,7 @@
 // Surface scattering in a local frame whose +z is the shading normal. `wo`
 // points toward the viewer (or the previous path vertex), `wi` toward the next
 // vertex; both unit length. The f64 CPU twin is src/sampling/, and the GPU
-// test of the twins is tests/sampling_gpu.rs.
+// test of the twins is tests/sampling/sampling_gpu.rs.
 #ifndef BSDF_GLSL
 #define BSDF_GLSL
 

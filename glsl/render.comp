@@ -74,6 +74,8 @@ layout(constant_id = SPEC_FILTER_MODE) const uint FILTER_MODE = FILTER_NONE;
 // LOOKUP_EWA (the reference lookup), for the filtered modes.
 layout(constant_id = SPEC_LOOKUP_MODE) const uint LOOKUP_MODE = LOOKUP_PROBES;
 
+#include "path_footprint.glsl"
+
 // A texture lookup over a footprint; FILTER_NONE ignores the footprint.
 vec4 lookup(uint index, Footprint fp) {
     if (FILTER_MODE == FILTER_NONE) return mapAt(index, fp.uv);
@@ -110,19 +112,11 @@ vec3 heightAndSlopes(uint index, vec2 uv) {
     return vec3(h, dhdu, dhdv);
 }
 
-// A ray cone's footprint on the surface, in the basis (t1, t2): σ across the
-// ray, σ / |cos θ| along t1 (stretch bounded: MIN_FOOTPRINT_COS).
-mat2 coneFootprint(vec3 d, vec3 n, float sigma) {
-    float inv = 1.0 / max(abs(dot(d, n)), MIN_FOOTPRINT_COS);
-    return mat2(sigma * sigma * inv * inv, 0.0, 0.0, sigma * sigma);
-}
-
 // The material at a hit with its texture maps applied, and the shading normal
 // (outward, tilted by the normal and displacement maps). `d` is the ray's
-// direction and `footprint` the covariance of the ray's footprint on the
-// surface (world units, in the basis of footprintBasis): texture lookups
-// average over it.
-Material surfaceAt(SceneHit h, vec3 d, mat2 footprint, out vec3 shadingNormal) {
+// direction and `hf` the ray's footprint on the surface (its covariance in
+// world units, in the basis hf.t1, hf.t2): texture lookups average over it.
+Material surfaceAt(SceneHit h, vec3 d, HitFootprint hf, out vec3 shadingNormal) {
     Object obj = objects[h.object];
     Material mat = materials[obj.material];
     shadingNormal = h.normal;
@@ -140,8 +134,8 @@ Material surfaceAt(SceneHit h, vec3 d, mat2 footprint, out vec3 shadingNormal) {
     // semi-axes whose outer products sum to the footprint's covariance in (u, v).
     Footprint fp;
     fp.uv = s.uv;
-    vec3 t1, t2;
-    footprintBasis(d, n, t1, t2);
+    mat2 footprint = hf.footprint;
+    vec3 t1 = hf.t1, t2 = hf.t2;
     float l11 = sqrt(max(footprint[0][0], 0.0));
     float l21 = l11 > 0.0 ? footprint[0][1] / l11 : 0.0;
     float l22 = sqrt(max(footprint[1][1] - l21 * l21, 0.0));
@@ -304,6 +298,7 @@ uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
 // mapping is locally affine; `none` jitters over the whole filter.
 float footprintSigma() { return FILTER_MODE == FILTER_NONE ? 0.0 : frame.pixelSigma * sqrt(frame.footprintFraction); }
 
+
 // The jitter of sample `sampleIndex` in pixel `pix`, in pixels from the
 // pixel's centre: a stratified point (the R2 sequence, M. Roberts 2018, in
 // 32-bit fixed point, rotated per pixel and seed by Cranley-Patterson)
@@ -452,6 +447,16 @@ bool survives(inout vec3 throughput, float etaScale, uint bounce, inout uint rng
 
 #include "stack.glsl"
 
+// A scattering event in a medium, for the weight of a positional light that
+// the sampled direction reaches: the segment it was on (origin, end
+// distance; direction), where on it, and the density σ_t T(t) there.
+struct MediumScatter {
+    vec4 segment;
+    vec3 dir;
+    float t;
+    float density;
+};
+
 // Caustic paths: with CAUSTICS_ENABLED, the caustic map gives the light that
 // reaches the primary vertex (when it is the diffuse receiver seen through
 // the pixel centre) from point, sphere and directional lights through one or
@@ -460,18 +465,10 @@ bool survives(inout vec3 throughput, float etaScale, uint bounce, inout uint rng
 // through such vertices only; every other path is estimated as usual.
 vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     MediaStack media = emptyStack();
-    // Ray cone (Akenine-Möller et al., "Improved Shader and Texture Level of
-    // Detail Using Ray Cones", JCGT 2021), kept as a Gaussian: σ of the
-    // width at the ray's origin and of the spread angle, starting from the
-    // footprint's share of the pixel filter (cameraJitter). Curved surfaces
-    // turn the spread by their exact mean curvature (below). A rough or
-    // diffuse lobe does not widen it: the lobe is sampled, and counting its
-    // bandwidth in the footprint as well would filter twice.
-    float coneWidth = 0.0;
+    // The footprint (ray cone or covariance, path_footprint.glsl) starts as
+    // its share of the pixel filter (cameraJitter).
     float pixelAngle = 2.0 * length(frame.up) / float(frame.height);
-    float coneSpread = footprintSigma() * pixelAngle;
-    // Covariance footprints (FILTER_COVARIANCE), from the same share.
-    PathCovariance cov = covCamera(d, normalize(frame.up), footprintSigma() * pixelAngle);
+    PathFootprint foot = footprintAtCamera(d, footprintSigma() * pixelAngle);
     vec3 radiance = vec3(0.0);
     vec3 throughput = vec3(1.0);
     // The product of the η² factors refractions divided the throughput by
@@ -479,13 +476,9 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     float etaScale = 1.0;
     float lastPdf = 0.0;      // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
     vec3 lastPoint = o;
-    // After a scattering event in a medium: the segment it was on (origin,
-    // end distance; direction), where on it, and the density σ_t T(t) of
-    // scattering there (0 after any other vertex).
-    vec4 scatterSegment = vec4(0.0);
-    vec3 scatterDir = vec3(0.0);
-    float scatterT = 0.0;
-    float scatterDensity = 0.0;
+    // After a scattering event in a medium: where it was (0 density after
+    // any other vertex).
+    MediumScatter scatter = MediumScatter(vec4(0.0), vec3(0.0), 0.0, 0.0);
     uint choices = lightChoices();
     // Caustic paths: true while the path has gone from the primary receiver
     // through the specular vertices that the caustic map covers; their count.
@@ -579,18 +572,8 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                        throughput, radiance);
                 lastPoint = p;
                 // For the weight of a positional light this direction may hit.
-                scatterSegment = vec4(o, tl);
-                scatterDir = d;
-                scatterT = ts;
-                scatterDensity = med.density * exp(-med.density * ts);
-                // Footprints: travel to p and turn to the new direction (the
-                // phase lobe is sampled, so its spread is not added).
-                if (FILTER_MODE == FILTER_COVARIANCE) {
-                    covTravel(cov, ts);
-                    covScatter(cov, wi);
-                } else if (FILTER_MODE == FILTER_RAY_CONES) {
-                    coneWidth += coneSpread * ts;
-                }
+                scatter = MediumScatter(vec4(o, tl), d, ts, med.density * exp(-med.density * ts));
+                footprintScatter(foot, ts, wi);
                 d = wi;
                 o = p;
                 // A scattering event on the camera ray's first segment is a
@@ -607,12 +590,12 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             // An emitter: a sphere or rect light, or the environment.
             vec3 le = which != frame.lightCount ? v3(lights[which].color) : environmentRadiance(d);
             float w = 1.0;
-            if (lastPdf > 0.0 && scatterDensity > 0.0 && which != frame.lightCount) {
+            if (lastPdf > 0.0 && scatter.density > 0.0 && which != frame.lightCount) {
                 // After a scattering event in a medium, a positional light
                 // competes with the equiangular estimate of that segment.
-                Equiangular e = equiangularSetup(scatterSegment.xyz, scatterDir, scatterSegment.w, lightCentre(which));
-                float pA = equiangularPdf(e, scatterT) * lightPdf(lights[which], lastPoint, d) / float(choices);
-                w = powerHeuristic(scatterDensity * lastPdf, pA);
+                Equiangular e = equiangularSetup(scatter.segment.xyz, scatter.dir, scatter.segment.w, lightCentre(which));
+                float pA = equiangularPdf(e, scatter.t) * lightPdf(lights[which], lastPoint, d) / float(choices);
+                w = powerHeuristic(scatter.density * lastPdf, pA);
             } else if (lastPdf > 0.0 && (which != frame.lightCount || environmentLit())) {
                 w = powerHeuristic(lastPdf, lightOrEnvironmentPdf(which, lastPoint, d) / float(choices));
             }
@@ -648,19 +631,10 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         }
 
         vec3 ns;
-        float width = coneWidth + coneSpread * h.t;
-        mat2 footprint;
-        // The footprint's tangent basis at this hit, shared by every filter step.
-        vec3 ct1, ct2;
-        footprintBasis(d, h.normal, ct1, ct2);
-        float covInv = 1.0;
-        if (FILTER_MODE == FILTER_COVARIANCE) {
-            covTravel(cov, h.t);
-            footprint = covOnSurface(cov, d, h.normal, ct1, ct2, covInv);
-        } else {
-            footprint = coneFootprint(d, h.normal, width);
-        }
-        Material mat = surfaceAt(h, d, footprint, ns);
+        // The footprint at this hit, built once: the texture lookups and the
+        // bounce below share it.
+        HitFootprint hitFoot = footprintAtHit(foot, d, h.normal, h.t);
+        Material mat = surfaceAt(h, d, hitFoot, ns);
         if (SHADING_MODE == SHADING_NONE) return v3(mat.albedo);
         if (SHADING_MODE == SHADING_MIRRORED_ALBEDO && mat.kind != MATERIAL_MIRROR) {
             return throughput * v3(mat.albedo);
@@ -743,34 +717,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             }
         }
         if (FILTER_MODE != FILTER_NONE && !last) {
-            // The outgoing footprint: the normal facing the incoming ray tilts
-            // by S u at surface offset u (S: its shape operator, exact from
-            // the Hessian of F'), which turns the outgoing direction by the
-            // gains g ⊙ (S u) (covariance.glsl, covBounce); refraction also
-            // scales the angles.
-            bool transmitted = bs.wi.z * wo.z < 0.0;
-            float cosI = abs(wo.z), cosT = max(abs(bs.wi.z), 0.05);
-            vec2 scale = vec2(1.0), gain = vec2(2.0, 2.0 * cosI);
-            if (transmitted) {
-                // Angles scale by η cos θi / cos θt and η, with η = n_i / n_t.
-                float eta = wo.z > 0.0 ? 1.0 / mat.ior : mat.ior;
-                scale = vec2(eta * cosI / cosT, eta);
-                gain = vec2(eta * cosI / cosT - 1.0, eta * cosI - cosT);
-            } else if (mat.kind == MATERIAL_DIFFUSE) {
-                gain = vec2(1.0);
-            }
-            mat2 shape = shapeOperator(h, ct1, ct2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
-            if (FILTER_MODE == FILTER_COVARIANCE) {
-                covBounce(cov, covInv, ct1, ct2, normalize(frameW * bs.wi), scale, shape, gain);
-            } else {
-                // Ray cones: the curvature term of Akenine-Möller et al. 2021
-                // (the cone's edge rays turn by the gain times the mean
-                // curvature times the width; a convex mirror of radius R
-                // adds 2w/R), then the angle scale of a refraction.
-                float kappa = 0.5 * (shape[0][0] + shape[1][1]);
-                coneSpread = coneSpread * scale.x + 0.5 * (gain.x + gain.y) * kappa * width;
-                coneWidth = width;
-            }
+            footprintBounce(foot, hitFoot, h, d, normalize(frameW * bs.wi), wo, bs.wi, mat.kind, mat.ior);
         }
         // Transmitted: update the stack of media, and the η² factor the
         // weight divided the throughput by (mat.ior is n_inside / n_outside).
@@ -782,7 +729,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
         throughput *= bs.weight;
         // The albedo modes weigh no emitter against light sampling.
         lastPdf = SHADING_MODE == SHADING_FULL ? bs.pdf : 0.0;
-        scatterDensity = 0.0;
+        scatter.density = 0.0;
         lastPoint = p;
         d = next;
         o = offsetOrigin(p, h.normal, d, h.offset);
@@ -811,7 +758,7 @@ void main() {
         vec3 ns;
         // The whole pixel filter, as the footprint of the centre ray.
         float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * frame.pixelSigma;
-        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, coneFootprint(d, h.normal, sigma), ns).albedo);
+        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, coneHitFootprint(d, h.normal, sigma), ns).albedo);
         aov.albedo = float[3](alb.x, alb.y, alb.z);
         aov.object = h.object;
         aovs[idx] = aov;

@@ -1,6 +1,6 @@
 #version 460
 // Filtered texture lookups on footprints given by the host (EWA or the
-// trilinear probes): the GPU side of the lookup and LEAN tests (tests/texfilter_gpu.rs), which compare them with
+// trilinear probes): the GPU side of the lookup and LEAN tests (tests/render/texfilter_gpu.rs), which compare them with
 // analytic averages and with the slope variance measured on the CPU.
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_EXT_nonuniform_qualifier : require

@@ -1,6 +1,6 @@
 #version 460
 // Runs the GLSL sampling routines (bsdf.glsl, lights.glsl) on inputs given
-// by the host, so that tests/sampling_gpu.rs can compare them with their f64
+// by the host, so that tests/sampling/sampling_gpu.rs can compare them with their f64
 // CPU twins (src/sampling/).
 #extension GL_EXT_scalar_block_layout : require
 

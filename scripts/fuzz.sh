@@ -3,7 +3,7 @@
 # bounded time. Usage: scripts/fuzz.sh [SECONDS] (default 300).
 # Seeds the corpus with the scene files of scenes/. A crash is written to
 # fuzz/artifacts/scene_parser/; copy it to tests/fuzz_crashes/NAME.toml so
-# that `make test` replays it (tests/parser_fuzz.rs).
+# that `make test` replays it (tests/scene/parser_fuzz.rs).
 # Needs the nightly toolchain (rustup toolchain install nightly) and
 # cargo-fuzz (installed here if missing). Memory is capped at 2 GB: the
 # parser may legitimately generate large textures (up to 16384² texels),

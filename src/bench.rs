@@ -231,20 +231,42 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
     std::fs::write(&json, serde_json::to_string_pretty(&report).expect("serialisable")).map_err(io(&json))?;
     let md = config.out_dir.join("bench.md");
     std::fs::write(&md, markdown(&report)).map_err(io(&md))?;
+    write_plot(&report, &config.out_dir)?;
+    Ok(report)
+}
+
+/// Draws `bench.png` in `out_dir`: FLIP against GPU time, one line per scene
+/// through its presets.
+pub fn write_plot(report: &Report, out_dir: &Path) -> Result<(), BenchError> {
     let series: Vec<Series> = report
         .scenes
         .iter()
         .map(|s| Series { label: s.scene.clone(), points: s.presets.iter().map(|r| (r.gpu_seconds, r.flip)).collect() })
         .collect();
-    let names: Vec<&str> = config.presets.iter().map(|p| p.name()).collect();
+    let first = report.scenes.first();
+    let names: Vec<&str> = first.map(|s| s.presets.iter().map(|r| r.preset.as_str()).collect()).unwrap_or_default();
+    let (w, h) = first.map_or((0, 0), |s| (s.width, s.height));
     write_log_log_plot(
-        &config.out_dir.join("bench.png"),
+        &out_dir.join("bench.png"),
         &format!("Presets ({}) against reference, {w}x{h}", names.join(", ")),
         "GPU time (s)",
         "FLIP vs reference",
         &series,
         &[],
     )?;
+    Ok(())
+}
+
+/// Reads the `bench.json` an earlier run wrote in `out_dir` and draws its
+/// `bench.png` again, rendering nothing.
+pub fn replot(out_dir: &Path) -> Result<Report, BenchError> {
+    let json = out_dir.join("bench.json");
+    let io = |source| BenchError::Io { path: json.clone(), source };
+    let text = std::fs::read_to_string(&json).map_err(io)?;
+    let report: Report = serde_json::from_str(&text).map_err(|e| {
+        io(std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not a report of this version: {e}")))
+    })?;
+    write_plot(&report, out_dir)?;
     Ok(report)
 }
 

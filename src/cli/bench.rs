@@ -70,6 +70,10 @@ pub(crate) struct BenchArgs {
     /// Print progress even when stderr is not a terminal.
     #[arg(long)]
     pub(crate) progress: bool,
+    /// Render nothing: read the `bench.json` an earlier run wrote in the
+    /// output folder and draw `bench.png` again.
+    #[arg(long)]
+    pub(crate) replot: bool,
     /// Enable the Khronos validation layer (fails on any error).
     #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     pub(crate) validation: bool,
@@ -138,8 +142,8 @@ pub(crate) struct FilterBenchArgs {
     #[arg(long, value_enum, default_value_t = Lookup::Probes)]
     pub(crate) lookup: Lookup,
     /// Render nothing: read the reports earlier runs wrote in the output
-    /// folder for these scenes and write `summary.md` and `headline.json`
-    /// over them.
+    /// folder for these scenes, draw their plots again and write
+    /// `summary.md` and `headline.json` over them.
     #[arg(long)]
     pub(crate) summarize_only: bool,
     /// Enable the Khronos validation layer (fails on any error).
@@ -232,6 +236,11 @@ pub(crate) fn filter_bench(args: FilterBenchArgs) -> Result<()> {
 }
 
 pub(crate) fn bench_presets(args: BenchArgs) -> Result<()> {
+    if args.replot {
+        quadray::bench::replot(&args.out)?;
+        eprintln!("wrote {}/bench.png", args.out.display());
+        return Ok(());
+    }
     let mut scenes = Vec::new();
     for name in &args.scenes {
         let (scene_name, source, file) = if name == "default" {

@@ -218,8 +218,9 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Vec<SceneReport>, BenchErro
 }
 
 /// Reads the reports that earlier runs wrote for `config.scenes`
-/// (`OUT/<scene>.json`) and writes `summary.md` and `headline.json` over
-/// them, rendering nothing: a summary over scenes measured in separate runs.
+/// (`OUT/<scene>.json`), draws their plots again and writes `summary.md` and
+/// `headline.json` over them, rendering nothing: a summary over scenes
+/// measured in separate runs.
 pub fn summarize(config: &Config) -> Result<Vec<SceneReport>, BenchError> {
     let mut reports = Vec::new();
     for path in &config.scenes {
@@ -227,6 +228,7 @@ pub fn summarize(config: &Config) -> Result<Vec<SceneReport>, BenchError> {
         let text = std::fs::read_to_string(&json).map_err(io_error(&json))?;
         let report: SceneReport = serde_json::from_str(&text)
             .map_err(|e| BenchError::Settings(format!("{}: not a report of this version: {e}", json.display())))?;
+        report::write_plots(&config.out_dir, &stem_of(path), &report)?;
         reports.push(report);
     }
     write_summaries(config, &reports)?;

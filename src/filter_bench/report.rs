@@ -239,6 +239,14 @@ pub(super) fn write_scene_outputs(config: &Config, stem: &str, report: &SceneRep
     let md = scene_markdown(report);
     write_all_or_nothing(&[json_path.clone(), md_path], |i, p| std::fs::write(p, if i == 0 { &json } else { &md }))
         .map_err(io_error(&json_path))?;
+    write_plots(&config.out_dir, stem, report)?;
+    eprintln!("wrote {}/{stem}.{{json,md}} and {stem}-{{relmse,relmse-mask,flip}}.png", config.out_dir.display());
+    Ok(())
+}
+
+/// Draws the plots of one scene's report: relative MSE (whole image and
+/// texture mask) and FLIP against GPU time, as `OUT/<stem>-<metric>.png`.
+pub(super) fn write_plots(out_dir: &Path, stem: &str, report: &SceneReport) -> Result<(), BenchError> {
     type Value = fn(&Point) -> f64;
     let plots: [(&str, &str, Value, bool); 3] = [
         ("relmse", "relative MSE", |p| p.whole.error, false),
@@ -265,13 +273,12 @@ pub(super) fn write_scene_outputs(config: &Config, stem: &str, report: &SceneRep
                 Some(HLine { label: t.name.clone(), y: value(p) })
             })
             .collect();
-        let path = config.out_dir.join(format!("{stem}-{metric}.png"));
+        let path = out_dir.join(format!("{stem}-{metric}.png"));
         let title =
             format!("{stem}: {label} against GPU time ({}x{}, {} seeds)", report.width, report.height, report.seeds);
         write_log_log_plot(&path, &title, "GPU seconds", label, &series, &hlines)
             .map_err(|source| BenchError::Plot { path: path.clone(), source })?;
     }
-    eprintln!("wrote {}/{stem}.{{json,md}} and {stem}-{{relmse,relmse-mask,flip}}.png", config.out_dir.display());
     Ok(())
 }
 

@@ -564,7 +564,7 @@ pub struct CausticPush {
 }
 
 /// Every struct the host shares with the shaders, for the member-by-member
-/// check against their SPIR-V (`tests/interface.rs`): names (GLSL
+/// check against their SPIR-V (`tests/scene/interface.rs`): names (GLSL
 /// `camelCase` as Rust `snake_case`), order, offsets, sizes. This replaces
 /// checks by size, which a swap of two fields of one type passes.
 pub fn host_layouts() -> Vec<HostLayout> {

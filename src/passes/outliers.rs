@@ -11,7 +11,7 @@
 //! estimation. With the power heuristic, light sampling's contribution is
 //! `f cos L w_l / p_l = (f cos / p_b) · L · p_l p_b / (p_l² + p_b²)`, at most
 //! `a L / 2` where `a = f cos / p_b` is the BSDF's weight in that direction,
-//! at most 1 (the albedo for Lambert; tests/sampling_gpu.rs checks it at
+//! at most 1 (the albedo for Lambert; tests/sampling/sampling_gpu.rs checks it at
 //! every angle), and `L` the largest emitted radiance. Every vertex, the last included, uses
 //! multiple importance sampling (render.comp: the last vertex still samples
 //! its BSDF and looks for an emitter in that direction), so each vertex adds

@@ -1,4 +1,4 @@
-//! Log-log axes: data bounds, decade ranges, ticks and the plot's layout.
+//! Log-log axes: data bounds, decade ranges, ticks and their labels.
 
 use super::*;
 
@@ -29,7 +29,7 @@ impl DataBounds {
         Some(bounds)
     }
 
-    pub(super) fn include_y(&mut self, y: f64) {
+    fn include_y(&mut self, y: f64) {
         self.y_min = self.y_min.min(y);
         self.y_max = self.y_max.max(y);
     }
@@ -37,28 +37,28 @@ impl DataBounds {
 
 /// How close (in decades) data may come to the end of an axis before the
 /// axis is widened by another half decade.
-pub(super) const AXIS_MARGIN_DECADES: f64 = 0.02;
+const AXIS_MARGIN_DECADES: f64 = 0.02;
 
 /// Slack for comparing tick positions with the axis ends.
-pub(super) const LOG_EPSILON: f64 = 1e-9;
+const LOG_EPSILON: f64 = 1e-9;
 
 /// An axis range in decades: `lo` and `hi` are base-10 logarithms.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct LogRange {
+pub(super) struct Decades {
     pub(super) lo: f64,
     pub(super) hi: f64,
 }
 
-impl LogRange {
+impl Decades {
     /// The smallest range of whole or half decades holding `[min, max]` with
     /// a little margin; never empty.
     pub(super) fn padded(min: f64, max: f64) -> Self {
         let lo = ((min.log10() - AXIS_MARGIN_DECADES) * 2.0).floor() / 2.0;
         let hi = ((max.log10() + AXIS_MARGIN_DECADES) * 2.0).ceil() / 2.0;
         if hi > lo {
-            LogRange { lo, hi }
+            Decades { lo, hi }
         } else {
-            LogRange { lo: lo - 0.5, hi: lo + 0.5 }
+            Decades { lo: lo - 0.5, hi: lo + 0.5 }
         }
     }
 
@@ -66,7 +66,16 @@ impl LogRange {
         self.hi - self.lo
     }
 
-    pub(super) fn contains_log(&self, log: f64) -> bool {
+    /// The ends in data units.
+    pub(super) fn lo_value(&self) -> f64 {
+        10f64.powf(self.lo)
+    }
+
+    pub(super) fn hi_value(&self) -> f64 {
+        10f64.powf(self.hi)
+    }
+
+    fn contains_log(&self, log: f64) -> bool {
         log >= self.lo - LOG_EPSILON && log <= self.hi + LOG_EPSILON
     }
 
@@ -74,13 +83,6 @@ impl LogRange {
     /// 1 at `hi`.
     pub(super) fn fraction_of_log(&self, log: f64) -> f64 {
         (log - self.lo) / self.decades()
-    }
-
-    /// The powers of ten whose exponents lie within the range.
-    pub(super) fn decade_exponents(&self) -> impl Iterator<Item = i32> + '_ {
-        let first = self.lo.floor() as i32;
-        let last = self.hi.ceil() as i32;
-        (first..=last).filter(|&e| self.contains_log(f64::from(e)))
     }
 
     /// The multiples of each power of ten that get a labelled tick: 1, 2 and
@@ -108,12 +110,31 @@ impl LogRange {
             .filter(|tick| self.contains_log(tick.log10()))
             .collect()
     }
+
+    /// The values 1x..9x of each power of ten within the range that are not
+    /// among `ticks`: the faint gridlines.
+    pub(super) fn minor_values(&self, ticks: &[Tick]) -> Vec<f64> {
+        let first = self.lo.floor() as i32;
+        let last = self.hi.ceil() as i32;
+        (first..=last)
+            .flat_map(|exponent| (1..=9).map(move |mantissa| Tick { mantissa, exponent }))
+            .filter(|tick| self.contains_log(tick.log10()) && !ticks.contains(tick))
+            .map(Tick::value)
+            .collect()
+    }
 }
 
 /// Every how many decades to label so that at most about `max_labels` fit.
 pub(super) fn decade_step(decades: f64, max_labels: usize) -> i32 {
     let per_label = (decades / max_labels.max(1) as f64).ceil();
     per_label.clamp(1.0, f64::from(i32::MAX)) as i32
+}
+
+/// How many decade labels fit along `pixels` at `spacing` apart, judged by
+/// the label count per decade of `range`.
+pub(super) fn label_count(pixels: i32, spacing: i32, range: Decades) -> usize {
+    let fitting = usize::try_from((pixels / spacing.max(1)).max(2)).unwrap_or(2);
+    (fitting / range.tick_mantissas().len()).max(1)
 }
 
 /// A labelled tick at `mantissa * 10^exponent`.
@@ -128,8 +149,20 @@ impl Tick {
         f64::from(self.exponent) + f64::from(self.mantissa).log10()
     }
 
-    pub(super) fn is_decade(self) -> bool {
-        self.mantissa == 1
+    pub(super) fn value(self) -> f64 {
+        f64::from(self.mantissa) * 10f64.powi(self.exponent)
+    }
+
+    /// The tick `mantissa * 10^exponent` (mantissa 1 to 9) nearest `value`
+    /// (positive): the inverse of [`Self::value`] for the ticks plotted.
+    pub(super) fn nearest(value: f64) -> Self {
+        let mut exponent = value.log10().floor() as i32;
+        let mut mantissa = (value / 10f64.powi(exponent)).round();
+        if mantissa >= 10.0 {
+            exponent += 1;
+            mantissa = 1.0;
+        }
+        Tick { mantissa: mantissa.clamp(1.0, 9.0) as u8, exponent }
     }
 
     /// Plain decimals from 0.01 to 5000 ("0.05", "10"), else short
@@ -142,116 +175,4 @@ impl Tick {
             _ => format!("{}e{}", self.mantissa, self.exponent),
         }
     }
-}
-
-/// An axis-aligned rectangle of pixels; all four edges are inclusive.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct Rect {
-    pub(super) left: i32,
-    pub(super) top: i32,
-    pub(super) right: i32,
-    pub(super) bottom: i32,
-}
-
-impl Rect {
-    pub(super) fn with_size(left: i32, top: i32, width: i32, height: i32) -> Self {
-        Rect { left, top, right: left + width - 1, bottom: top + height - 1 }
-    }
-
-    pub(super) fn contains(&self, (x, y): (i32, i32)) -> bool {
-        (self.left..=self.right).contains(&x) && (self.top..=self.bottom).contains(&y)
-    }
-
-    pub(super) fn width(&self) -> i32 {
-        self.right - self.left + 1
-    }
-
-    pub(super) fn height(&self) -> i32 {
-        self.bottom - self.top + 1
-    }
-}
-
-pub(super) const TICK_SCALE: i32 = 2;
-pub(super) const LABEL_SCALE: i32 = 2;
-pub(super) const TITLE_SCALE: i32 = 3;
-pub(super) const OUTER_PAD: i32 = 12;
-pub(super) const TICK_LENGTH: i32 = 6;
-pub(super) const MINOR_TICK_LENGTH: i32 = 3;
-pub(super) const TICK_LABEL_GAP: i32 = 5;
-pub(super) const AXIS_LABEL_GAP: i32 = 10;
-pub(super) const RIGHT_MARGIN: i32 = 34;
-/// Least spacing between labelled decades, in pixels.
-pub(super) const MIN_X_LABEL_SPACING: i32 = 80;
-pub(super) const MIN_Y_LABEL_SPACING: i32 = 40;
-/// Least pixels per decade for unlabelled decade gridlines and minor ticks.
-pub(super) const MIN_DECADE_PIXELS_FOR_GRID: f64 = 8.0;
-pub(super) const MIN_DECADE_PIXELS_FOR_MINOR_TICKS: f64 = 40.0;
-
-/// Where the plot area lies in the image, and the axes' ranges and ticks.
-#[derive(Clone, Debug, PartialEq)]
-pub(super) struct Layout {
-    pub(super) size: (i32, i32),
-    pub(super) plot: Rect,
-    pub(super) x: LogRange,
-    pub(super) y: LogRange,
-    pub(super) x_ticks: Vec<Tick>,
-    pub(super) y_ticks: Vec<Tick>,
-}
-
-impl Layout {
-    pub(super) fn new(size: (u32, u32), bounds: &DataBounds) -> Self {
-        let (width, height) = (to_i32(size.0), to_i32(size.1));
-        let x = LogRange::padded(bounds.x_min, bounds.x_max);
-        let y = LogRange::padded(bounds.y_min, bounds.y_max);
-        let top = OUTER_PAD + text_height(TITLE_SCALE) + OUTER_PAD;
-        let bottom_margin = TICK_LENGTH
-            + TICK_LABEL_GAP
-            + text_height(TICK_SCALE)
-            + AXIS_LABEL_GAP
-            + text_height(LABEL_SCALE)
-            + OUTER_PAD;
-        let plot_height = height - top - bottom_margin;
-        let y_ticks = y.ticks(label_count(plot_height, MIN_Y_LABEL_SPACING, y));
-        let widest_y_label = y_ticks.iter().map(|t| text_width(&t.label(), TICK_SCALE)).max().unwrap_or(0);
-        let left =
-            OUTER_PAD + text_height(LABEL_SCALE) + AXIS_LABEL_GAP + widest_y_label + TICK_LABEL_GAP + TICK_LENGTH;
-        let plot_width = width - left - RIGHT_MARGIN;
-        let x_ticks = x.ticks(label_count(plot_width, MIN_X_LABEL_SPACING, x));
-        let plot = Rect::with_size(left, top, plot_width, plot_height);
-        Layout { size: (width, height), plot, x, y, x_ticks, y_ticks }
-    }
-
-    pub(super) fn x_pixel_of_log(&self, log: f64) -> i32 {
-        let span = f64::from(self.plot.right - self.plot.left);
-        self.plot.left + (self.x.fraction_of_log(log) * span).round() as i32
-    }
-
-    pub(super) fn y_pixel_of_log(&self, log: f64) -> i32 {
-        let span = f64::from(self.plot.bottom - self.plot.top);
-        self.plot.bottom - (self.y.fraction_of_log(log) * span).round() as i32
-    }
-
-    /// The pixel of the data point `(x, y)`; both must be positive.
-    pub(super) fn to_pixel(&self, (x, y): (f64, f64)) -> (i32, i32) {
-        (self.x_pixel_of_log(x.log10()), self.y_pixel_of_log(y.log10()))
-    }
-
-    pub(super) fn pixels_per_x_decade(&self) -> f64 {
-        f64::from(self.plot.width()) / self.x.decades()
-    }
-
-    pub(super) fn pixels_per_y_decade(&self) -> f64 {
-        f64::from(self.plot.height()) / self.y.decades()
-    }
-}
-
-/// How many decade labels fit along `pixels` at `spacing` apart, judged by
-/// the label count per decade of `range`.
-pub(super) fn label_count(pixels: i32, spacing: i32, range: LogRange) -> usize {
-    let fitting = usize::try_from((pixels / spacing.max(1)).max(2)).unwrap_or(2);
-    (fitting / range.tick_mantissas().len()).max(1)
-}
-
-pub(super) fn to_i32(value: u32) -> i32 {
-    i32::try_from(value).unwrap_or(i32::MAX)
 }

@@ -6,7 +6,7 @@
 //! host binds and specialises against it, so the `BINDING_*` and `SPEC_*`
 //! numbers of `src/shader_interface.rs` are the only place both sides meet;
 //! the GPU structs of `passes::gpu` are checked member by member against
-//! the layouts here (`tests/interface.rs`).
+//! the layouts here (`tests/scene/interface.rs`).
 
 use std::collections::{BTreeMap, HashMap};
 

@@ -7,12 +7,41 @@ use std::sync::Arc;
 use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3};
 use quadray::geometry::{Aabb, FunctionalObject, Perturbation, Quadric};
 use quadray::scene::{Camera, ImageSettings, Light, Material, Scene, SceneObject};
-use quadray::vk::{Context, ValidationCounters};
+use quadray::vk::{Commands, Context, ValidationCounters};
 
 /// A headless context with the Khronos validation layer on.
 pub fn context() -> Context {
     let _ = env_logger::builder().is_test(true).filter_level(log::LevelFilter::Warn).try_init();
     Context::new(true).expect("a Vulkan device with ray queries and the validation layer (run `make setup`)")
+}
+
+/// The scene file `scenes/<relative>` of the project, parsed.
+pub fn project_scene(relative: &str) -> Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(relative);
+    quadray::scene::load_scene(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Points the camera of `scene` from `position` at `look_at`.
+pub fn aim(scene: &mut Scene, position: DVec3, look_at: DVec3) {
+    scene.camera.position = position;
+    scene.camera.look_at = look_at;
+}
+
+/// Sets the image size, samples per pixel and path depth of `scene`.
+pub fn set_image(scene: &mut Scene, (width, height): (u32, u32), spp: u32, max_depth: u32) {
+    scene.image.width = width;
+    scene.image.height = height;
+    scene.image.spp = spp;
+    scene.image.max_depth = max_depth;
+}
+
+/// A validated context, its validation counters and a command buffer: what
+/// the GPU tests that dispatch probes start from.
+pub fn gpu() -> (Context, Arc<ValidationCounters>, Commands) {
+    let ctx = context();
+    let counters = ctx.counters();
+    let cmds = Commands::new(&ctx.device).expect("a command pool on the device");
+    (ctx, counters, cmds)
 }
 
 /// Fails when the validation layer reported any error; call after dropping
@@ -232,8 +261,7 @@ pub const EQUAL_TIME_MARGIN: f64 = 1.5;
 /// writes the three images there as `{name}_*.png`.
 pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> BruteForceComparison {
     use quadray::passes::RenderVariant;
-    let path = format!("{}/scenes/tests/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-    let mut scene = quadray::scene::load_scene(std::path::Path::new(&path)).unwrap();
+    let mut scene = project_scene(&format!("tests/{name}.toml"));
     let brute_force = RenderVariant { caustics: false, volume: false, ..Default::default() };
     scene.image.spp = reference_spp;
     let reference = render_variant_validated(&scene, brute_force);

@@ -25,7 +25,7 @@ use std::process::{Command, Output, Stdio};
 use exr::prelude::{read_all_flat_layers_from_file, AnyChannels, FlatSamples, Layer};
 
 /// A unit sphere at the origin, the camera on +z looking at it.
-const SPHERE_SCENE: &str = r#"# A unit sphere for tests/cli.rs; the test computes every pixel analytically.
+const SPHERE_SCENE: &str = r#"# A unit sphere for tests/cli/commands.rs; the test computes every pixel analytically.
 background = [0.1, 0.2, 0.3]
 
 [image]

@@ -12,7 +12,7 @@
 //!   over a floor: the irradiance is that of a point light of the same
 //!   intensity, I cos³θ / h², and no pixel is NaN or Inf.
 
-mod common;
+use crate::common;
 
 use quadray::scene::parse_scene;
 

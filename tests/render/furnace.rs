@@ -15,7 +15,7 @@
 //! (energy lost at silhouettes or in creases) cannot hide in the noise. No
 //! NaN or Inf.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{FunctionalObject, Quadric};
@@ -129,13 +129,9 @@ fn ggx_conductor_loses_only_the_single_scattering_energy() {
         }];
         scene.lights.clear();
         scene.background = Vec3::ONE;
-        scene.camera.position = DVec3::new(0.0, 0.0, 4.0);
-        scene.camera.look_at = DVec3::ZERO;
+        common::aim(&mut scene, DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO);
         scene.camera.vfov_degrees = 32.0;
-        scene.image.width = 40;
-        scene.image.height = 40;
-        scene.image.spp = 512;
-        scene.image.max_depth = 8;
+        common::set_image(&mut scene, (40, 40), 512, 8);
         let out = common::render_validated(&scene);
         let table: Vec<f64> = (0..=40).map(|k| ggx_albedo(roughness as f64, (k as f64 / 40.0).max(1e-3))).collect();
         let albedo_at = |c: f64| {

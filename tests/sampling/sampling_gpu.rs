@@ -1,6 +1,6 @@
 //! The GLSL sampling routines (glsl/bsdf.glsl, glsl/lights.glsl, run by
 //! glsl/twins.comp) against their f64 CPU twins (src/sampling/), which the
-//! chi-square tests (tests/sampling_chi2.rs) check against their pdfs. Same
+//! chi-square tests (tests/sampling/sampling_chi2.rs) check against their pdfs. Same
 //! inputs on both sides; the outputs must agree within f32 precision:
 //! directions within `DIR_TOL`, weights, radiance and densities within
 //! `REL_TOL` relative to max(|cpu|, |gpu|, `FLOOR`): values far below the
@@ -13,7 +13,7 @@
 //! direction) may go either way and are counted, not compared; their share
 //! must stay below `MAX_EDGE_SHARE`.
 
-mod common;
+use crate::common;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3};
@@ -67,7 +67,7 @@ struct TwinPush {
 }
 
 /// The test's structs match twins.comp member by member (names, offsets,
-/// sizes), as `tests/interface.rs` checks those of `passes::gpu`.
+/// sizes), as `tests/scene/interface.rs` checks those of `passes::gpu`.
 #[test]
 fn twin_structs_match_the_shader() {
     let iface = quadray::vk::reflect::ShaderInterface::reflect(&quadray::shaders::twins()).unwrap();

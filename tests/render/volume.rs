@@ -2,7 +2,7 @@
 //! scene (`scenes/tests/fog_shadow.toml`: a sphere light behind a ball in
 //! haze), and its absence where there is no fog.
 
-mod common;
+use crate::common;
 
 use quadray::passes::RenderVariant;
 
@@ -27,8 +27,7 @@ fn fog_with_shadow_matches_the_brute_force_path_tracer() {
 
 #[test]
 fn scenes_without_fog_run_no_volume_pass() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/tests/lens.toml");
-    let scene = quadray::scene::load_scene(std::path::Path::new(path)).unwrap();
+    let scene = common::project_scene("tests/lens.toml");
     assert!(!scene.needs_volume());
     let out = common::render_variant_validated(&scene, RenderVariant::default());
     assert!(out.volume_seconds.is_none(), "the volume pass ran");

@@ -5,7 +5,7 @@
 //! within `SLOPE_BAND` of -0.5. An estimator with a bias (or a seed that does
 //! not decorrelate samples) flattens the slope.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};
@@ -53,11 +53,9 @@ fn glossy_scene() -> Scene {
         Light::Sphere { centre: DVec3::new(3.0, 2.0, 2.0), radius: 0.4, radiance: Vec3::splat(10.0) },
     ];
     scene.background = Vec3::new(0.05, 0.06, 0.08);
-    scene.camera.position = DVec3::new(0.0, 2.2, 5.0);
-    scene.camera.look_at = DVec3::new(0.0, 0.8, 0.0);
-    scene.image.width = 32;
-    scene.image.height = 24;
-    scene.image.max_depth = 6;
+    common::aim(&mut scene, DVec3::new(0.0, 2.2, 5.0), DVec3::new(0.0, 0.8, 0.0));
+    let spp = scene.image.spp;
+    common::set_image(&mut scene, (32, 24), spp, 6);
     scene
 }
 

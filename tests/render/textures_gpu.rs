@@ -7,7 +7,7 @@
 //! `BORDER` (in cells) of a cell edge are skipped (bilinear filtering blends
 //! neighbouring texels there, and f32 hit points differ slightly).
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
 use quadray::geometry::uv::object_uv;

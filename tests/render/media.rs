@@ -10,7 +10,7 @@
 //!   function's sampling and next-event estimation through the medium, and
 //!   their multiple importance sampling.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{FunctionalObject, Quadric};
@@ -102,12 +102,8 @@ fn scattering_fog_in_a_box_of_lights_is_a_furnace() {
         scene.materials = vec![Material::diffuse("white", Vec3::ONE)];
         scene.lights = light_box(2.0, 1.0);
         scene.fog = Some(Medium { density, albedo: Vec3::ONE, anisotropy: g });
-        scene.camera.position = DVec3::new(0.2, 0.4, 1.7);
-        scene.camera.look_at = DVec3::ZERO;
-        scene.image.width = 32;
-        scene.image.height = 24;
-        scene.image.spp = 256;
-        scene.image.max_depth = 256;
+        common::aim(&mut scene, DVec3::new(0.2, 0.4, 1.7), DVec3::ZERO);
+        common::set_image(&mut scene, (32, 24), 256, 256);
         let out = common::render_validated(&scene);
         let common::UniformStats { mean, standard_error, worst } = common::UniformStats::of(&out, 1.0);
         println!(

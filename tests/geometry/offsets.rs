@@ -13,7 +13,7 @@
 //! gaps the scene has. The cases run from D/r = 10 to 1e5, and r from 1e-4
 //! to 1.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{FunctionalObject, Quadric};

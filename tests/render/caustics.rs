@@ -10,7 +10,7 @@
 //!   caustic passes against a long brute-force render (FLIP).
 //! - A scene without specular objects runs no caustic pass.
 
-mod common;
+use crate::common;
 
 use quadray::passes::RenderVariant;
 use quadray::sampling::fresnel::fresnel_dielectric;
@@ -104,8 +104,7 @@ fn lens_over_plane_matches_the_brute_force_path_tracer() {
 
 #[test]
 fn scenes_without_specular_objects_run_no_caustic_pass() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/tests/one_sphere.toml");
-    let scene = quadray::scene::load_scene(std::path::Path::new(path)).unwrap();
+    let scene = common::project_scene("tests/one_sphere.toml");
     assert!(!scene.needs_caustics());
     let out = common::render_variant_validated(&scene, RenderVariant::default());
     assert!(out.caustics.is_none(), "caustic passes ran");

@@ -6,7 +6,7 @@
 //! (flux) albedo, and the smooth limit.
 //!
 //! Every chi-square test prints its χ², degrees of freedom and p-value
-//! (`cargo test --test dielectric_chi2 -- --nocapture`). A test fails when its
+//! (`cargo test --test sampling -- dielectric_chi2:: --nocapture`). A test fails when its
 //! p-value is below the Šidák-corrected level for a family-wise level of 0.01
 //! over the [`CHI2_TESTS`] tests of this file, or when ∫pdf dω differs from the
 //! fraction of valid samples by more than 1e-2 (see `sampling::chi2`). The

@@ -10,7 +10,7 @@
 //!   filtering to the coarsest level against the one that the slope variance
 //!   measured on the CPU (from the height field, in f64) predicts.
 
-mod common;
+use crate::common;
 
 use glam::{DVec2, DVec3, Vec3};
 use quadray::geometry::{FunctionalObject, Quadric};
@@ -20,7 +20,6 @@ use quadray::scene::{Material, MaterialMaps};
 
 use quadray::passes::LookupMode;
 use quadray::texture::{bump_heights, checker, lean, normals_from_heights, TextureImage};
-use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -147,9 +146,7 @@ fn check_lookup_on_the_checker(name: &str, lookup: LookupMode, bound: impl Fn(f6
     let cases = checker_cases();
     let queries: Vec<_> = cases.iter().map(|&(_, _, uv, a1, a2)| query(0, uv, a1, a2, 0.0)).collect();
 
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
     let results = TexProbePass::with_lookup(&ctx.device, &gpu, &queries, lookup).unwrap().run(&mut cmds).unwrap();
     drop(gpu);
@@ -248,9 +245,7 @@ fn trilinear_probes_average_to_the_exact_gaussian_under_jitter() {
         .iter()
         .flat_map(|&(_, _, uv, a1, a2)| grid.iter().map(move |&(s, t, _)| query(0, uv + a1 * s + a2 * t, a1, a2, 0.0)))
         .collect();
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
     let results =
         TexProbePass::with_lookup(&ctx.device, &gpu, &queries, LookupMode::Probes).unwrap().run(&mut cmds).unwrap();
@@ -337,9 +332,7 @@ fn lean_filtering_of_random_bumps_gives_the_predicted_roughness() {
         scene.materials.push(m);
     }
 
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let gpu = GpuScene::new(&ctx.device, &mut cmds, &scene, &Default::default()).unwrap();
     // The moments follow the scene's textures, in material order.
     let moments: Vec<u32> = (0..cases.len()).map(|i| (cases.len() + i) as u32).collect();

@@ -16,7 +16,7 @@
 //! stored in 8-bit sRGB (`texture::encoding`) and must still be read at
 //! full resolution: a checker of single texels in its blue channel.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
 use quadray::geometry::uv::object_uv;

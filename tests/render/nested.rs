@@ -8,7 +8,7 @@
 //! `NOISE_RATIO`). Without the stack of media, the inner
 //! ball would refract with index 1.5 against vacuum and show.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{FunctionalObject, Quadric};
@@ -52,12 +52,8 @@ fn scene(inner: bool) -> Scene {
     // A checkered look through the ball comes from the floor's light and shadow.
     s.lights = vec![Light::Sphere { centre: DVec3::new(2.0, 4.0, 3.0), radius: 0.5, radiance: Vec3::splat(30.0) }];
     s.background = Vec3::new(0.2, 0.25, 0.3);
-    s.camera.position = DVec3::new(0.0, 1.5, 4.5);
-    s.camera.look_at = DVec3::new(0.0, 1.0, 0.0);
-    s.image.width = 48;
-    s.image.height = 36;
-    s.image.spp = 256;
-    s.image.max_depth = 12;
+    common::aim(&mut s, DVec3::new(0.0, 1.5, 4.5), DVec3::new(0.0, 1.0, 0.0));
+    common::set_image(&mut s, (48, 36), 256, 12);
     s
 }
 

@@ -13,7 +13,7 @@
 //!   analytic Hessian) within `MAX_CURVATURE_ERROR` (`FAR_*` for rays from
 //!   1e3..1e4 away).
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3};
 use quadray::geometry::{reference, Aabb, CellParams};
@@ -22,7 +22,6 @@ use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
 use quadray::scene::SceneObject;
 use quadray::shader_interface::NO_HIT;
-use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -269,9 +268,7 @@ fn gpu_hits_match_the_f64_reference() {
         }
     }
 
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let scene = common::scene_with(objects.clone());
     let gpu_scene = GpuScene::new(&ctx.device, &mut cmds, &scene, &CellParams::default()).unwrap();
     println!(

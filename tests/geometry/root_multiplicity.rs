@@ -18,7 +18,7 @@
 //! here), plus 2⁻²³ of the distance. The table printed shows where that limit
 //! makes the result useless (the error exceeds the gap to the other roots).
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3};
 use quadray::geometry::{Aabb, CellParams, FunctionalObject, Perturbation, Quadric};
@@ -26,7 +26,6 @@ use quadray::passes::gpu::GpuRay;
 use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
 use quadray::shader_interface::NO_HIT;
-use quadray::vk::Commands;
 
 const F32_EPSILON: f64 = 1.0 / 8_388_608.0;
 const CONDITIONING_FACTOR: f64 = 64.0;
@@ -39,9 +38,7 @@ struct Probe {
 }
 
 fn trace(shape: FunctionalObject, probes: &[Probe]) -> Vec<quadray::passes::gpu::GpuHit> {
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let scene = common::scene_with(vec![common::object("shape", shape, DAffine3::IDENTITY)]);
     let gpu = GpuScene::with_origin(&ctx.device, &mut cmds, &scene, &CellParams::default(), DVec3::ZERO).unwrap();
     let rays: Vec<GpuRay> = probes.iter().map(|p| p.ray).collect();

@@ -17,7 +17,7 @@
 //! change of F' that dense f64 sampling of the ray finds (an arbiter where
 //! the GPU and the reference disagree).
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3};
 use quadray::geometry::{reference, CellParams, FunctionalObject, Quadric};
@@ -49,6 +49,16 @@ struct Agreement {
     failures: usize,
     max_depth: f64,
     max_normal: f64,
+}
+
+impl Agreement {
+    /// The table columns: hits, agree, excused, failures, max depth, max normal°.
+    fn columns(&self) -> String {
+        format!(
+            "{:>6} {:>6} {:>8} {:>8} {:>11.2e} {:>11.4}",
+            self.hits, self.agree, self.excused, self.failures, self.max_depth, self.max_normal
+        )
+    }
 }
 
 /// Traces `rays` rays from 6 `s` away from `centre` toward random points of
@@ -152,9 +162,7 @@ fn scales_and_offsets_against_the_f64_reference() {
         perturbations: common::spread_bumps(40, 1.0, 0.3, 0.5, true),
         clip: None,
     };
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let mut rng = Pcg64::seed_from_u64(3);
     println!(
         "{:>9} {:>8} {:>8} {:>9} {:>6} {:>6} {:>8} {:>8} {:>11} {:>11} {:>8}",
@@ -186,13 +194,8 @@ fn scales_and_offsets_against_the_f64_reference() {
                 let bounded = epsilon <= TRUSTED_EPSILON;
                 let frame = if relative { "relative" } else { "world" };
                 println!(
-                    "{frame:>9} {s:>8.0e} {offset:>8.0e} {epsilon:>9.1e} {:>6} {:>6} {:>8} {:>8} {:>11.2e} {:>11.4} {:>8}",
-                    a.hits,
-                    a.agree,
-                    a.excused,
-                    a.failures,
-                    a.max_depth,
-                    a.max_normal,
+                    "{frame:>9} {s:>8.0e} {offset:>8.0e} {epsilon:>9.1e} {} {:>8}",
+                    a.columns(),
                     if bounded { "yes" } else { "no" }
                 );
                 if bounded
@@ -328,9 +331,7 @@ fn extremes() -> Vec<Extreme> {
 /// figures.
 #[test]
 fn shapes_at_the_extremes_against_the_f64_reference() {
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let mut rng = Pcg64::seed_from_u64(7);
     println!(
         "{:>22} {:>6} {:>6} {:>8} {:>8} {:>11} {:>11}",
@@ -342,14 +343,9 @@ fn shapes_at_the_extremes_against_the_f64_reference() {
         let origin = DVec3::new(0.0, 0.0, 6.0);
         let a = measure(&ctx, &mut cmds, &mut rng, &e.shape, transform, origin, 1.0, e.aim, e.rays);
         println!(
-            "{:>22} {:>6} {:>6} {:>8} {:>8} {:>11.2e} {:>11.4}   bounds: failures {} of {}, depth {:.0e}, normal {}°",
+            "{:>22} {}   bounds: failures {} of {}, depth {:.0e}, normal {}°",
             e.name,
-            a.hits,
-            a.agree,
-            a.excused,
-            a.failures,
-            a.max_depth,
-            a.max_normal,
+            a.columns(),
             (e.max_failures * e.rays as f64).round(),
             e.rays,
             e.max_depth,

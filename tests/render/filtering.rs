@@ -10,7 +10,7 @@
 //! filtering (`none`, one bilinear lookup) the same pixels alias: they read
 //! the colour of whatever cell the ray hits.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};
@@ -110,8 +110,7 @@ const NO_BIAS_TOLERANCE: f64 = 0.1;
 /// `NO_BIAS_TOLERANCE`.
 #[test]
 fn filtering_adds_no_bias_without_textures() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/materials.toml");
-    let mut scene = quadray::scene::load_scene(&path).unwrap();
+    let mut scene = common::project_scene("materials.toml");
     assert!(scene.textures.is_empty(), "the test needs a scene without textures");
     scene.image.width = 96;
     scene.image.height = 72;
@@ -290,8 +289,7 @@ const GLOSSY_FALL: f64 = 0.5;
 /// `GLOSSY_FALL` each time.
 #[test]
 fn filtered_albedo_through_a_glossy_reflector_converges_to_the_reference() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tests/glossy_reflector.toml");
-    let scene = quadray::scene::load_scene(&path).unwrap();
+    let scene = common::project_scene("tests/glossy_reflector.toml");
     let ctx = common::context();
     let counters = ctx.counters();
     let render = |filter: FilterMode, spp: u32, seed: u32| -> Vec<f64> {

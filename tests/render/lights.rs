@@ -18,7 +18,7 @@
 //! against a pixel-centre reference) below `RMS_BOUND`. Pixels where a
 //! jittered camera ray can see a sphere light directly are skipped.
 
-mod common;
+use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};

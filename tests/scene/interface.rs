@@ -25,9 +25,9 @@ fn applies(layout: &HostLayout, shader: &str) -> bool {
 
 /// Structs of the shaders that have no twin in `passes::gpu`, and why.
 const NOT_IN_GPU_RS: [(&str, &str, &str); 3] = [
-    ("twins", "Push", "the test's push constants, checked with its Rust twin in tests/sampling_gpu.rs"),
-    ("twins", "TwinCase", "a test input, checked with its Rust twin in tests/sampling_gpu.rs"),
-    ("twins", "TwinResult", "a test output, checked with its Rust twin in tests/sampling_gpu.rs"),
+    ("twins", "Push", "the test's push constants, checked with its Rust twin in tests/sampling/sampling_gpu.rs"),
+    ("twins", "TwinCase", "a test input, checked with its Rust twin in tests/sampling/sampling_gpu.rs"),
+    ("twins", "TwinResult", "a test output, checked with its Rust twin in tests/sampling/sampling_gpu.rs"),
 ];
 
 #[test]

@@ -6,18 +6,16 @@
 //! report what the render did; and no handful of pixels dominates the
 //! error of a 16-spp render.
 
-mod common;
-
-use std::path::Path;
+use crate::common;
 
 use quadray::passes::outliers::{describe_path, largest_sample, luminance, outliers, SampleBound};
 use quadray::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
 use quadray::passes::{IntersectMode, LookupMode, ShadingMode};
-use quadray::scene::{load_scene, parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+use quadray::scene::{parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 use quadray::vk::{Commands, Context};
 
 fn stress_scene() -> Scene {
-    load_scene(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/tests/energy_stress.toml"))).unwrap()
+    common::project_scene("tests/energy_stress.toml")
 }
 
 /// The path tracer alone: the bound speaks of its samples.
@@ -48,9 +46,7 @@ fn no_sample_exceeds_its_bound_in_the_stress_scene() {
     let mut scene = stress_scene();
     let bound = SampleBound::of(&scene).unwrap();
     let (width, height, spp, seeds) = (128u32, 96u32, 102u32, 8u32);
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let gpu = upload(&ctx, &mut cmds, &scene);
     let sized = scene.resized(width, height, spp);
     let mut renderer = Renderer::new(&ctx.device, &mut cmds, &gpu, &sized, BRUTE_FORCE).unwrap();
@@ -103,9 +99,7 @@ fn no_sample_exceeds_its_bound_in_the_stress_scene() {
 fn the_largest_sample_aov_is_a_sample_the_recorder_reproduces() {
     let scene = stress_scene();
     let (width, height, spp) = (48u32, 36u32, 8u32);
-    let ctx = common::context();
-    let counters = ctx.counters();
-    let mut cmds = Commands::new(&ctx.device).unwrap();
+    let (ctx, counters, mut cmds) = common::gpu();
     let gpu = upload(&ctx, &mut cmds, &scene);
     let out = common::finite(
         quadray::passes::render(

@@ -1,0 +1,13 @@
+//! The exact geometry on the GPU: first roots against f64 CPU twins, offsets, root multiplicity, the stress suite and covariance tracing.
+//!
+//! One test binary per theme (each module was a binary of its own), so the
+//! suite links a few executables instead of thirty.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod covariance;
+mod geometry_gpu;
+mod offsets;
+mod root_multiplicity;
+mod stress_geometry;

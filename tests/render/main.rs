@@ -1,0 +1,20 @@
+//! Rendered images against analytic values, references and brute force: furnaces, lights, media, caustics, volumes, filtering, textures, convergence and energy.
+//!
+//! One test binary per theme (each module was a binary of its own), so the
+//! suite links a few executables instead of thirty.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod caustics;
+mod convergence;
+mod energy;
+mod filtering;
+mod furnace;
+mod lights;
+mod media;
+mod nested;
+mod texfilter_gpu;
+mod textures_gpu;
+mod transport_extremes;
+mod volume;
