@@ -8,6 +8,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 use cli::bench::*;
+use cli::devices::*;
 use cli::farm::*;
 use cli::images::*;
 use cli::render::*;
@@ -61,6 +62,11 @@ enum Command {
     /// renders and farms").
     #[command(subcommand)]
     Farm(FarmCommand),
+    /// List the Vulkan devices: driver, version, the ray-tracing extensions
+    /// and features the renderer uses (ray queries, ray-tracing pipelines,
+    /// acceleration structures, float64, 64-bit atomics, timestamps), what
+    /// each lacks per backend, and which device and backend a render takes.
+    Devices(DevicesArgs),
     /// Measure samples per second and CPU use of whole `quadray render`
     /// processes on the throughput scenes, optionally beside an older binary
     /// (`--baseline`) in the same run; writes throughput.json and
@@ -103,6 +109,7 @@ fn main() -> Result<()> {
         Some(Command::Throughput(args)) => throughput(args, set_threads),
         Some(Command::Merge(args)) => merge(args),
         Some(Command::Farm(cmd)) => farm(cmd),
+        Some(Command::Devices(args)) => devices(args),
         None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),
     }
 }

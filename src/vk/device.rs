@@ -8,6 +8,7 @@ use std::sync::{Arc, Mutex};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
+use super::capabilities::{preference, Backend, Capabilities};
 use super::{Instance, VkError};
 
 /// The device extensions the renderer cannot work without.
@@ -50,63 +51,6 @@ pub struct Device {
 pub struct AccelProperties {
     /// Alignment of scratch buffer addresses.
     pub min_scratch_offset_alignment: u32,
-}
-
-/// What one physical device lacks for the renderer; empty when it fits.
-fn shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Vec<String> {
-    let mut missing = Vec::new();
-    let props = unsafe { instance.get_physical_device_properties(pd) };
-    if props.api_version < vk::API_VERSION_1_2 {
-        missing.push("Vulkan 1.2".to_string());
-    }
-    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
-    for req in REQUIRED_EXTENSIONS {
-        if !exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == req).unwrap_or(false)) {
-            missing.push(req.to_string_lossy().into_owned());
-        }
-    }
-    if missing.is_empty() {
-        let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
-        let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
-        let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
-        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12).push_next(&mut fas).push_next(&mut frq);
-        unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-        let float64 = f2.features.shader_float64;
-        let int64 = f2.features.shader_int64;
-        if f12.buffer_device_address == 0 {
-            missing.push("bufferDeviceAddress".into());
-        }
-        if f12.scalar_block_layout == 0 {
-            missing.push("scalarBlockLayout".into());
-        }
-        if f12.shader_sampled_image_array_non_uniform_indexing == 0 {
-            missing.push("shaderSampledImageArrayNonUniformIndexing".into());
-        }
-        if fas.acceleration_structure == 0 {
-            missing.push("accelerationStructure".into());
-        }
-        if frq.ray_query == 0 {
-            missing.push("rayQuery".into());
-        }
-        // The intersection re-bases rays near each object in f64.
-        if float64 == 0 {
-            missing.push("shaderFloat64".into());
-        }
-        // The caustic map adds irradiance with 64-bit integer atomics.
-        if int64 == 0 {
-            missing.push("shaderInt64".into());
-        }
-        if f12.shader_buffer_int64_atomics == 0 {
-            missing.push("shaderBufferInt64Atomics".into());
-        }
-    }
-    let has_compute = unsafe { instance.get_physical_device_queue_family_properties(pd) }
-        .iter()
-        .any(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE));
-    if !has_compute {
-        missing.push("a compute queue".into());
-    }
-    missing
 }
 
 /// What one physical device lacks to present to `surface` from its first
@@ -163,20 +107,27 @@ impl Device {
         let mut fits = Vec::new();
         for &pd in &devices {
             let props = unsafe { raw_instance.get_physical_device_properties(pd) };
-            let mut missing = shortcomings(raw_instance, pd);
+            let caps = Capabilities::query(raw_instance, pd);
+            let mut missing: Vec<String> = caps.lacks(Backend::RayQuery).into_iter().map(String::from).collect();
             missing.extend(more(raw_instance, pd));
-            let name = device_name(&props);
             if missing.is_empty() {
-                let rank = match props.device_type {
-                    vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-                    vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-                    vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-                    _ => 3,
-                };
-                fits.push((rank, pd));
-                report.push(format!("  {name}: suitable"));
+                fits.push((preference(props.device_type), pd));
+                report.push(format!("  {}: suitable", caps.name));
             } else {
-                report.push(format!("  {name}: lacks {}", missing.join(", ")));
+                // Per backend: what the device lacks for each, so that a GPU
+                // with ray-tracing pipelines but no ray queries is told apart
+                // from one that lacks float64.
+                let mut lines = caps.backend_lines();
+                if caps.lacks(Backend::RayQuery).is_empty() {
+                    lines[0] = format!("{}: lacks {}", Backend::RayQuery, missing.join(", "));
+                }
+                report.push(format!(
+                    "  {} ({}):
+    {}",
+                    caps.name,
+                    caps.device_type,
+                    lines.join("\n    ")
+                ));
             }
         }
         let Some(&(_, physical)) = fits.iter().min_by_key(|(rank, _)| *rank) else {

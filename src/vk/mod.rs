@@ -5,6 +5,7 @@
 
 mod accel;
 mod buffer;
+mod capabilities;
 mod commands;
 mod device;
 mod image;
@@ -23,6 +24,7 @@ use std::sync::Arc;
 pub use accel::{AccelerationStructure, Instance as AsInstance};
 pub use ash::vk;
 pub use buffer::Buffer;
+pub use capabilities::{preference, survey, Backend, Capabilities, PipelineLimits, Survey};
 pub use commands::{full_barrier, Commands};
 pub use device::{Device, SETUP_HINT};
 pub use gpu_allocator::MemoryLocation;

@@ -645,3 +645,37 @@ fn bench_writes_its_report_and_caches_the_reference() {
     let log = render_ok(&args, dir, &[]);
     assert!(log.contains("using the cached reference"), "{log}");
 }
+
+/// `quadray devices` lists lavapipe with what the renderer uses (Mesa 25
+/// offers both ray queries and ray-tracing pipelines, float64, 64-bit
+/// atomics and timestamps) and says a render takes it with ray queries.
+#[test]
+fn devices_lists_the_drivers_capabilities_and_the_backend_auto_takes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = quadray(&["devices", "--json"], dir.path(), &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let devices = report["devices"].as_array().expect("a device list");
+    let lavapipe = devices.iter().find(|d| d["driver_name"] == "llvmpipe").expect("lavapipe is listed");
+    for flag in
+        ["ray_query", "ray_tracing_pipeline", "acceleration_structure", "float64", "int64_atomics", "timestamps"]
+    {
+        assert_eq!(lavapipe[flag], true, "lavapipe's {flag}");
+    }
+    let limits = &lavapipe["pipeline_limits"];
+    assert!(limits["shader_group_handle_size"].as_u64().unwrap() >= 16, "{limits}");
+    assert!(limits["max_ray_recursion_depth"].as_u64().unwrap() >= 1, "{limits}");
+    assert_eq!(lavapipe["lacks"]["ray-query"], serde_json::json!([]));
+    assert_eq!(lavapipe["auto_backend"], "ray-query");
+    assert_eq!(report["auto"]["backend"], "ray-query");
+    let index = report["auto"]["index"].as_u64().unwrap() as usize;
+    assert_eq!(devices[index]["ray_query"], true);
+    println!("auto: {} with {}", report["auto"]["device"], report["auto"]["backend"]);
+
+    let text = quadray(&["devices"], dir.path(), &[]);
+    assert!(text.status.success());
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("backend ray-query: supported"), "{text}");
+    assert!(text.contains("auto: device "), "{text}");
+    assert!(entries(dir.path()).is_empty(), "devices writes nothing");
+}
