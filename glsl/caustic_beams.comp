@@ -17,6 +17,8 @@
 // Photon Points and Beams"). The sum goes to the beam map (radiance, fixed
 // point) that the render pass adds on the camera ray's first segment.
 #extension GL_EXT_shader_atomic_int64 : require
+// This pass traces no rays.
+#define NO_TRACING
 #include "interface.glsl"
 #include "frame.glsl"
 #include "caustics.glsl"

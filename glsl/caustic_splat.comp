@@ -14,6 +14,8 @@
 // its plane) gets the interpolated irradiance, added with 64-bit integer
 // atomics in fixed point (cells overlap where the caustic folds).
 #extension GL_EXT_shader_atomic_int64 : require
+// This pass traces no rays.
+#define NO_TRACING
 #include "interface.glsl"
 #include "frame.glsl"
 #include "caustics.glsl"

@@ -66,4 +66,46 @@ mat2 shapeOperator(SceneHit h, vec3 t1, vec3 t2) {
     return mat2(s11, s12, s12, s22);
 }
 
+// A miss.
+SceneHit noHit() {
+    SceneHit h;
+    h.t = NO_ROOT;
+    h.object = NO_HIT;
+    h.cell = 0u;
+    h.normal = vec3(0.0);
+    h.gradientLength = 0.0;
+    h.objectPoint = vec3(0.0);
+    h.worldToObject = mat3(1.0);
+    h.offset = 0.0;
+    return h;
+}
+
+// The rest of a closest hit of o + t d, given its t, object, cell and
+// object-space point: the world normal from the gradient of F', and the
+// secondary-ray offset. Both backends (traverse.glsl, traverse_pipeline.glsl)
+// finish their hits here.
+void completeHit(inout SceneHit h, vec3 o, vec3 d, mat3 worldToObject) {
+    vec3 g = cellGradient(h.object, h.cell, h.objectPoint);
+    h.worldToObject = worldToObject;
+    vec3 n = -(transpose(h.worldToObject) * g);
+    float len = length(n);
+    h.normal = len > 0.0 ? n / len : -d;
+    h.gradientLength = len;
+    h.offset = hitOffset(o + h.t * d, h.cell, g, h.worldToObject);
+}
+
+// Object-frame distance of a ray's origin beyond which the object ray is
+// formed in f64.
+const float REBASE_DISTANCE = 64.0;
+
+// The ray in a candidate's object frame, in f64: the world-to-object
+// transform m applied in f64 to the f32 world origin and direction (the
+// hardware's f32 transform loses ~1e-7 of the origin's distance, 1e-3 at
+// 1e4, and turns the direction by ~1e-7 rad, as much again 1e4 away).
+void objectRay64(mat4x3 m, vec3 worldOrigin, vec3 worldDir, out dvec3 o, out dvec3 d) {
+    dmat3 l = dmat3(dvec3(m[0]), dvec3(m[1]), dvec3(m[2]));
+    o = l * dvec3(worldOrigin) + dvec3(m[3]);
+    d = l * dvec3(worldDir);
+}
+
 #endif

@@ -5,7 +5,15 @@
 #define INTERFACE_GLSL
 
 #extension GL_EXT_scalar_block_layout : require
+// Compute passes trace with ray queries; the ray-tracing-pipeline backend's
+// shaders (built with RAY_TRACING_PIPELINE defined) with traceRayEXT.
+// Passes that trace nothing (NO_TRACING defined) declare neither, nor the
+// acceleration structure, so that they run on a device with either.
+#if defined(RAY_TRACING_PIPELINE)
+#extension GL_EXT_ray_tracing : require
+#elif !defined(NO_TRACING)
 #extension GL_EXT_ray_query : require
+#endif
 #extension GL_EXT_control_flow_attributes : require
 
 #include "common.glsl"
@@ -46,7 +54,9 @@ struct Cell {
     uint count;
 };
 
+#ifndef NO_TRACING
 layout(set = 0, binding = BINDING_TLAS) uniform accelerationStructureEXT tlas;
+#endif
 layout(set = 0, binding = BINDING_OBJECTS, scalar) readonly buffer Objects { Object objects[]; };
 layout(set = 0, binding = BINDING_CELLS, scalar) readonly buffer Cells { Cell cells[]; };
 layout(set = 0, binding = BINDING_PERTURBATIONS, scalar) readonly buffer Perturbations { Perturbation perturbations[]; };

@@ -23,6 +23,10 @@ layout(constant_id = SPEC_INTERSECT_MODE) const uint INTERSECT_MODE = INTERSECT_
 #include "root_search.glsl"
 #include "derivatives.glsl"
 #include "hit.glsl"
+#ifdef RAY_TRACING_PIPELINE
+#include "traverse_pipeline.glsl"
+#else
 #include "traverse.glsl"
+#endif
 
 #endif

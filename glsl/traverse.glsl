@@ -13,19 +13,9 @@
 #define candidateCell(rq, object, committed) \
     (objects[object].firstCell + uint(rayQueryGetIntersectionPrimitiveIndexEXT(rq, committed)))
 
-// Object-frame distance of a ray's origin beyond which the object ray is
-// formed in f64.
-const float REBASE_DISTANCE = 64.0;
-
-// The ray in the candidate's object frame, in f64: the world-to-object
-// transform applied in f64 to the f32 world origin and direction (the
-// hardware's f32 transform loses ~1e-7 of the origin's distance, 1e-3 at
-// 1e4, and turns the direction by ~1e-7 rad, as much again 1e4 away).
 void candidateObjectRay64(rayQueryEXT rq, out dvec3 o, out dvec3 d) {
-    mat4x3 m = rayQueryGetIntersectionWorldToObjectEXT(rq, false);
-    dmat3 l = dmat3(dvec3(m[0]), dvec3(m[1]), dvec3(m[2]));
-    o = l * dvec3(rayQueryGetWorldRayOriginEXT(rq)) + dvec3(m[3]);
-    d = l * dvec3(rayQueryGetWorldRayDirectionEXT(rq));
+    objectRay64(rayQueryGetIntersectionWorldToObjectEXT(rq, false), rayQueryGetWorldRayOriginEXT(rq),
+                rayQueryGetWorldRayDirectionEXT(rq), o, d);
 }
 
 // Runs the candidate loop: for each AABB, the first root in the cell.
@@ -68,29 +58,14 @@ SceneHit traceSceneWith(vec3 o, vec3 d, float tmin, float tmax, bool anyHit) {
     uint flags = anyHit ? gl_RayFlagsTerminateOnFirstHitEXT : gl_RayFlagsNoneEXT;
     rayQueryInitializeEXT(rq, tlas, flags, 0xFF, o, tmin, d, tmax);
     vec3 point = proceedFunctional(rq, tmin, tmax);
-    SceneHit h;
-    h.t = NO_ROOT;
-    h.object = NO_HIT;
-    h.cell = 0u;
-    h.normal = vec3(0.0);
-    h.gradientLength = 0.0;
-    h.objectPoint = vec3(0.0);
-    h.worldToObject = mat3(1.0);
-    h.offset = 0.0;
+    SceneHit h = noHit();
     if (rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionGeneratedEXT) {
         h.t = rayQueryGetIntersectionTEXT(rq, true);
         h.object = candidateObject(rq, true);
         if (anyHit) return h;
-        uint cell = candidateCell(rq, h.object, true);
-        h.cell = cell;
+        h.cell = candidateCell(rq, h.object, true);
         h.objectPoint = point;
-        vec3 g = cellGradient(h.object, cell, h.objectPoint);
-        h.worldToObject = mat3(rayQueryGetIntersectionWorldToObjectEXT(rq, true));
-        vec3 n = -(transpose(h.worldToObject) * g);
-        float len = length(n);
-        h.normal = len > 0.0 ? n / len : -d;
-        h.gradientLength = len;
-        h.offset = hitOffset(o + h.t * d, cell, g, h.worldToObject);
+        completeHit(h, o, d, mat3(rayQueryGetIntersectionWorldToObjectEXT(rq, true)));
     }
     return h;
 }

@@ -47,3 +47,40 @@ shaders! {
     /// `glsl/volume.comp`: single scattering in the fog toward positional lights.
     volume,
 }
+
+/// The stages of the ray-tracing-pipeline backend, compiled from
+/// `glsl/NAME.EXT` with RAY_TRACING_PIPELINE defined.
+macro_rules! pipeline_shaders {
+    ($($(#[doc = $doc:literal])* $name:ident = $file:literal,)*) => {
+        $(
+            $(#[doc = $doc])*
+            pub fn $name() -> Vec<u32> {
+                words(include_bytes!(concat!(env!("OUT_DIR"), "/", $file, ".spv")))
+            }
+        )*
+
+        /// Every pipeline stage with its file name, for interface checks.
+        pub fn pipeline_all() -> Vec<(&'static str, Vec<u32>)> {
+            vec![$(($file, $name())),*]
+        }
+    };
+}
+
+pipeline_shaders! {
+    /// `glsl/render.rgen`: the path tracer's ray generation.
+    render_rgen = "render.rgen",
+    /// `glsl/gbuffer.rgen`: the caustic passes' G-buffer.
+    gbuffer_rgen = "gbuffer.rgen",
+    /// `glsl/caustic_trace.rgen`: the caustic rays.
+    caustic_trace_rgen = "caustic_trace.rgen",
+    /// `glsl/volume.rgen`: the volume pass.
+    volume_rgen = "volume.rgen",
+    /// `glsl/probe.rgen`: the probe pass's ray generation.
+    probe_rgen = "probe.rgen",
+    /// `glsl/intersect.rint`: the first root in a candidate box.
+    intersect_rint = "intersect.rint",
+    /// `glsl/closest_hit.rchit`: the closest hit into the payload.
+    closest_hit_rchit = "closest_hit.rchit",
+    /// `glsl/miss.rmiss`: a miss into the payload.
+    miss_rmiss = "miss.rmiss",
+}

@@ -154,3 +154,40 @@ pub(crate) fn read_scene(path: Option<&Path>) -> Result<Scene> {
         None => parse_scene(DEFAULT_SCENE, DEFAULT_SCENE_NAME)?,
     })
 }
+
+/// `--backend`: how rays are traced.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum BackendChoice {
+    /// Ray queries where the device has them, else a ray-tracing pipeline.
+    #[default]
+    Auto,
+    /// Compute shaders with ray queries (VK_KHR_ray_query).
+    RayQuery,
+    /// A ray-tracing pipeline with the intersection shader
+    /// (VK_KHR_ray_tracing_pipeline) for the render pass.
+    Pipeline,
+}
+
+impl BackendChoice {
+    /// The backend on `device`; `pipeline` on a device without ray-tracing
+    /// pipelines is an error.
+    pub(crate) fn resolve(self, device: &quadray::vk::Device) -> Result<quadray::vk::Backend> {
+        use quadray::vk::Backend;
+        match self {
+            BackendChoice::Auto if device.ray_query => Ok(Backend::RayQuery),
+            BackendChoice::Auto => Ok(Backend::Pipeline),
+            BackendChoice::RayQuery if device.ray_query => Ok(Backend::RayQuery),
+            BackendChoice::RayQuery => anyhow::bail!(
+                "{} offers no ray queries (VK_KHR_ray_query); `--backend pipeline` traces through ray-tracing \
+                 pipelines instead",
+                device.name
+            ),
+            BackendChoice::Pipeline if device.ray_tracing.is_some() => Ok(Backend::Pipeline),
+            BackendChoice::Pipeline => anyhow::bail!(
+                "{} offers no ray-tracing pipelines (VK_KHR_ray_tracing_pipeline); `quadray devices` lists what \
+                 each device offers",
+                device.name
+            ),
+        }
+    }
+}

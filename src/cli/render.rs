@@ -45,6 +45,12 @@ pub(crate) struct RenderArgs {
     /// those passes are compared with).
     #[arg(long)]
     pub(crate) brute_force: bool,
+    /// How the render pass traces rays: `auto` (ray queries where the device
+    /// has them), `ray-query`, or `pipeline` (a ray-tracing pipeline whose
+    /// intersection shader solves the first roots; the caustic and volume
+    /// passes still use ray queries). The images agree to float rounding.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto, env = "QUADRAY_BACKEND")]
+    pub(crate) backend: BackendChoice,
     /// Write checkpoints of the work so far to this file (atomically), every
     /// --checkpoint-every seconds and when the render is stopped by SIGINT,
     /// SIGTERM or --time-limit; removed once the render completes and its
@@ -150,11 +156,15 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
     }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
-    let variant =
-        quadray::passes::RenderVariant { caustics: !args.brute_force, volume: !args.brute_force, ..Default::default() };
+    let variant = quadray::passes::RenderVariant {
+        caustics: !args.brute_force,
+        volume: !args.brute_force,
+        backend: args.backend.resolve(&ctx.device)?,
+        ..Default::default()
+    };
     let mut interrupted = false;
     if args.bench {
-        let out = bench(&ctx, &scene)?;
+        let out = bench(&ctx, &scene, variant.backend)?;
         write_render(&args, &ctx, &scene, variant, &outputs, None, &out, quadray::job::JobEnd::Complete)?;
     } else {
         let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -303,7 +313,11 @@ pub(crate) fn write_render(
 }
 
 /// The benchmark mode of `render --bench`; returns the full render.
-pub(crate) fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray::passes::RenderOutput> {
+pub(crate) fn bench(
+    ctx: &quadray::vk::Context,
+    scene: &Scene,
+    backend: quadray::vk::Backend,
+) -> Result<quadray::passes::RenderOutput> {
     use quadray::passes::{render, GpuScene, RenderVariant};
 
     let device = &ctx.device;
@@ -313,23 +327,33 @@ pub(crate) fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray
     let variants = [
         (
             "full render",
-            RenderVariant { intersect: IntersectMode::Full, shading: ShadingMode::Full, ..Default::default() },
+            RenderVariant { intersect: IntersectMode::Full, shading: ShadingMode::Full, backend, ..Default::default() },
         ),
         (
             "perturbation root finding off",
-            RenderVariant { intersect: IntersectMode::Base, shading: ShadingMode::Full, ..Default::default() },
+            RenderVariant { intersect: IntersectMode::Base, shading: ShadingMode::Full, backend, ..Default::default() },
         ),
         (
             "shading and secondary rays off",
-            RenderVariant { intersect: IntersectMode::Full, shading: ShadingMode::Albedo, ..Default::default() },
+            RenderVariant {
+                intersect: IntersectMode::Full,
+                shading: ShadingMode::Albedo,
+                backend,
+                ..Default::default()
+            },
         ),
         (
             "traversal only (boxes are hits, no shading)",
-            RenderVariant { intersect: IntersectMode::Boxes, shading: ShadingMode::Albedo, ..Default::default() },
+            RenderVariant {
+                intersect: IntersectMode::Boxes,
+                shading: ShadingMode::Albedo,
+                backend,
+                ..Default::default()
+            },
         ),
     ];
     eprintln!(
-        "benchmark: {}x{}, {} spp, max depth {}, {} objects ({} perturbations, {} cells) on {}",
+        "benchmark: {}x{}, {} spp, max depth {}, {} objects ({} perturbations, {} cells) on {}, {} backend",
         im.width,
         im.height,
         im.spp,
@@ -337,7 +361,8 @@ pub(crate) fn bench(ctx: &quadray::vk::Context, scene: &Scene) -> Result<quadray
         scene.objects.len(),
         gpu.stats.perturbations,
         gpu.stats.cells,
-        device.name
+        device.name,
+        backend
     );
     let mut full = None;
     let mut rows = Vec::new();

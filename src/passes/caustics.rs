@@ -26,6 +26,7 @@ use glam::{DVec2, DVec3};
 
 use super::gpu::{CausticPush, GpuCausticRay, GpuEmitter, GpuReceiver};
 use super::scene_gpu::GpuScene;
+use super::tracer::Tracer;
 use super::IntersectMode;
 use crate::geometry::CellParams;
 use crate::scene::{Light, Scene};
@@ -34,7 +35,9 @@ use crate::shader_interface::{
     CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP, SPEC_INTERSECT_MODE,
     SPEC_MEDIA_ENABLED,
 };
-use crate::vk::{full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation};
+use crate::vk::{
+    full_barrier, vk, Backend, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation,
+};
 use crate::{shaders, RenderError};
 
 /// What the caustic passes did, and how long they took.
@@ -70,8 +73,8 @@ impl CausticReport {
 /// set of emission grids; [`CausticMap::run`] (re)computes the maps for the
 /// camera currently in the frame buffer.
 pub struct CausticMap {
-    gbuffer: ComputePipeline,
-    trace: ComputePipeline,
+    gbuffer: Tracer,
+    trace: Tracer,
     splat: ComputePipeline,
     beam: ComputePipeline,
     /// The caustic rays' landing points (`GpuCausticRay`).
@@ -223,27 +226,9 @@ fn parallel_grid(w: DVec3, irradiance: DVec3, corners: &[DVec3], centre: DVec3, 
 }
 
 impl CausticMap {
-    /// Runs the passes once for a `width` x `height` image whose frame
-    /// parameters are in `frame` (`GpuFrame`), with `grids` from
-    /// [`emitters`], and reads back the statistics (rays landed, irradiance).
-    pub fn compute(
-        device: &Arc<Device>,
-        cmds: &mut Commands,
-        gpu: &GpuScene,
-        scene: &Scene,
-        frame: &Buffer,
-        size: (u32, u32),
-        grids: &[GpuEmitter],
-    ) -> Result<Self, RenderError> {
-        let timer = GpuTimer::new(device)?;
-        let mut map = Self::new(device, gpu, scene, frame, size, grids)?;
-        map.run(cmds, &timer)?;
-        map.read_statistics();
-        Ok(map)
-    }
-
     /// Creates the pipelines and buffers for a `width` x `height` image whose
-    /// frame parameters are in `frame`; nothing runs yet.
+    /// frame parameters are in `frame`; nothing runs yet. The G-buffer and
+    /// the caustic rays trace with `backend`.
     pub fn new(
         device: &Arc<Device>,
         gpu: &GpuScene,
@@ -251,6 +236,7 @@ impl CausticMap {
         frame: &Buffer,
         (width, height): (u32, u32),
         grids: &[GpuEmitter],
+        backend: Backend,
     ) -> Result<Self, RenderError> {
         let pixels = width as u64 * height as u64;
         let ray_count: u64 = grids.iter().map(|g| g.grid[0] as u64 * g.grid[1] as u64).sum();
@@ -271,10 +257,12 @@ impl CausticMap {
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
         let intersect = gpu.intersect_mode(IntersectMode::Full).constant();
         let traced = [(SPEC_INTERSECT_MODE, intersect)];
-        let gbuffer = ComputePipeline::new(device, &shaders::gbuffer(), &traced)?;
-        let trace = ComputePipeline::new(
+        let gbuffer = Tracer::new(device, backend, shaders::gbuffer, shaders::gbuffer_rgen, &traced)?;
+        let trace = Tracer::new(
             device,
-            &shaders::caustic_trace(),
+            backend,
+            shaders::caustic_trace,
+            shaders::caustic_trace_rgen,
             &[(SPEC_INTERSECT_MODE, intersect), (SPEC_MEDIA_ENABLED, u32::from(scene.has_media()))],
         )?;
         let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &[])?;
@@ -286,9 +274,10 @@ impl CausticMap {
             (BINDING_CAUSTIC_MAP, Binding::Buffer(&map)),
             (BINDING_CAUSTIC_BEAMS, Binding::Buffer(&beams)),
         ]);
-        for p in [&gbuffer, &trace, &splat, &beam] {
-            p.bind(&bindings)?;
-        }
+        gbuffer.bind(&bindings)?;
+        trace.bind(&bindings)?;
+        splat.bind(&bindings)?;
+        beam.bind(&bindings)?;
         let report = CausticReport { rays: ray_count, grids: grids.len(), ..Default::default() };
         Ok(Self {
             gbuffer,
@@ -317,17 +306,18 @@ impl CausticMap {
                 d.cmd_fill_buffer(cmd, beams.raw, 0, vk::WHOLE_SIZE, 0);
             }
             full_barrier(d, cmd);
-            gbuffer.dispatch(cmd, &[], [width.div_ceil(RENDER_GROUP), height.div_ceil(RENDER_GROUP), 1]);
+            gbuffer.run(cmd, &[], [width, height], [RENDER_GROUP, RENDER_GROUP]);
             full_barrier(d, cmd);
         })?;
         report.gbuffer_seconds = t;
 
         let ((), t) = timer.run(cmds, |d, cmd| {
             for g in grids.iter() {
-                trace.dispatch(
+                trace.run(
                     cmd,
                     bytemuck::bytes_of(&CausticPush { emitter: *g }),
-                    [(g.grid[0] * g.grid[1]).div_ceil(CAUSTIC_GROUP), 1, 1],
+                    [g.grid[0] * g.grid[1], 1],
+                    [CAUSTIC_GROUP, 1],
                 );
             }
             full_barrier(d, cmd);

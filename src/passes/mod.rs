@@ -10,6 +10,7 @@ pub mod probe;
 pub mod render;
 pub mod scene_gpu;
 pub mod texprobe;
+pub mod tracer;
 pub mod variant;
 pub mod volume;
 
@@ -20,5 +21,6 @@ pub use probe::ProbePass;
 pub use render::{render, RecordedPath, RenderOutput, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene};
 pub use texprobe::TexProbePass;
+pub use tracer::Tracer;
 pub use variant::{IntersectMode, LookupMode, RenderVariant, ShadingMode};
 pub use volume::VolumeLight;

@@ -5,11 +5,12 @@ use std::sync::Arc;
 
 use super::gpu::{GpuHit, GpuRay, ProbePush};
 use super::scene_gpu::GpuScene;
+use super::tracer::Tracer;
 use super::IntersectMode;
 use crate::shader_interface::{
     BINDING_PROBE_HITS, BINDING_PROBE_RAYS, PROBE_GROUP, SPEC_INTERSECT_MODE, SPEC_PROBE_CURVATURE,
 };
-use crate::vk::{vk, Binding, Buffer, Commands, ComputePipeline, Device, MemoryLocation, Timestamps};
+use crate::vk::{vk, Backend, Binding, Buffer, Commands, Device, MemoryLocation, Timestamps};
 use crate::{shaders, RenderError};
 
 /// Rays per dispatch: short enough never to trip a driver watchdog.
@@ -17,7 +18,7 @@ const RAYS_PER_DISPATCH: u32 = 1 << 16;
 
 /// A ray-tracing pass over a fixed ray list.
 pub struct ProbePass {
-    pipeline: ComputePipeline,
+    tracer: Tracer,
     rays: Buffer,
     hits: Buffer,
     count: u32,
@@ -35,11 +36,21 @@ impl ProbePass {
         mode: IntersectMode,
         curvature: bool,
     ) -> Result<Self, RenderError> {
-        let pipeline = ComputePipeline::new(
-            device,
-            &shaders::probe(),
-            &[(SPEC_INTERSECT_MODE, mode.constant()), (SPEC_PROBE_CURVATURE, u32::from(curvature))],
-        )?;
+        Self::with_backend(device, scene, rays, mode, curvature, Backend::RayQuery)
+    }
+
+    /// [`ProbePass::new`] tracing with `backend`: ray queries (`probe.comp`)
+    /// or a ray-tracing pipeline (`probe.rgen` with the intersection shader).
+    pub fn with_backend(
+        device: &Arc<Device>,
+        scene: &GpuScene,
+        rays: &[GpuRay],
+        mode: IntersectMode,
+        curvature: bool,
+        backend: Backend,
+    ) -> Result<Self, RenderError> {
+        let spec = [(SPEC_INTERSECT_MODE, mode.constant()), (SPEC_PROBE_CURVATURE, u32::from(curvature))];
+        let tracer = Tracer::new(device, backend, shaders::probe, shaders::probe_rgen, &spec)?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::storage(
             device,
@@ -50,9 +61,9 @@ impl ProbePass {
         let mut bindings = scene.geometry_bindings().into_iter().collect::<Vec<_>>();
         bindings
             .extend([(BINDING_PROBE_RAYS, Binding::Buffer(&rays_buf)), (BINDING_PROBE_HITS, Binding::Buffer(&hits))]);
-        pipeline.bind(&bindings)?;
+        tracer.bind(&bindings)?;
         let timestamps = Timestamps::new(device, 2)?;
-        Ok(Self { pipeline, rays: rays_buf, hits, count: rays.len() as u32, timestamps })
+        Ok(Self { tracer, rays: rays_buf, hits, count: rays.len() as u32, timestamps })
     }
 
     /// Traces every ray; returns the hits and the GPU time in nanoseconds.
@@ -65,7 +76,7 @@ impl ProbePass {
             while first < self.count {
                 let n = (self.count - first).min(RAYS_PER_DISPATCH);
                 let push = ProbePush { first, count: n };
-                self.pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [n.div_ceil(PROBE_GROUP), 1, 1]);
+                self.tracer.run(cmd, bytemuck::bytes_of(&push), [n, 1], [PROBE_GROUP, 1]);
                 first += n;
             }
             self.timestamps.write(cmd, 1);

@@ -9,6 +9,7 @@ use super::caustics::{emitters, CausticMap, CausticReport};
 use super::checkpoint::Accumulation;
 use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathRecord, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
+use super::tracer::Tracer;
 use super::volume::VolumeLight;
 use super::{RenderVariant, ShadingMode};
 use crate::scene::Scene;
@@ -18,9 +19,7 @@ use crate::shader_interface::{
     RENDER_GROUP, SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED, SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE,
     SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
 };
-use crate::vk::{
-    full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, Image, MemoryLocation,
-};
+use crate::vk::{full_barrier, vk, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation};
 use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
@@ -189,7 +188,7 @@ fn gpu_frame(scene: &Scene, gpu: &GpuScene, width: u32, height: u32, spp: u32) -
 /// same estimate however it is split.
 pub struct Renderer {
     // Pipelines first: dropped before the buffers their descriptors name.
-    pipeline: ComputePipeline,
+    pipeline: Tracer,
     device: Arc<Device>,
     caustics: Option<CausticMap>,
     volume: Option<VolumeLight>,
@@ -294,7 +293,7 @@ impl Renderer {
         )?;
         let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant)?;
         let volume = if variant.volume && variant.shading == ShadingMode::Full && scene.needs_volume() {
-            Some(VolumeLight::new(device, gpu, &frame, (width, height))?)
+            Some(VolumeLight::new(device, gpu, &frame, (width, height), variant.backend)?)
         } else {
             None
         };
@@ -463,11 +462,7 @@ impl Renderer {
             let ((), seconds) = self.timer.run(cmds, |d, cmd| {
                 // Earlier submissions' writes to the accumulation image must be visible.
                 full_barrier(d, cmd);
-                pipeline.dispatch(
-                    cmd,
-                    bytemuck::bytes_of(&push),
-                    [t[2].div_ceil(RENDER_GROUP), t[3].div_ceil(RENDER_GROUP), 1],
-                )
+                pipeline.run(cmd, bytemuck::bytes_of(&push), [t[2], t[3]], [RENDER_GROUP, RENDER_GROUP])
             })?;
             self.render_seconds += seconds;
             self.tiles_done += 1;
@@ -643,7 +638,7 @@ impl Renderer {
         let pipeline = &self.pipeline;
         cmds.run(|d, cmd| {
             full_barrier(d, cmd);
-            pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [1, 1, 1]);
+            pipeline.run(cmd, bytemuck::bytes_of(&push), [1, 1], [1, 1]);
             full_barrier(d, cmd);
         })?;
         let bytes: Vec<u8> = self.path.read();
@@ -664,10 +659,12 @@ fn render_pipeline(
     variant: RenderVariant,
     caustics: Option<&CausticMap>,
     volume: bool,
-) -> Result<ComputePipeline, RenderError> {
-    Ok(ComputePipeline::new(
+) -> Result<Tracer, RenderError> {
+    Ok(Tracer::new(
         device,
-        &shaders::render(),
+        variant.backend,
+        shaders::render,
+        shaders::render_rgen,
         &[
             (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect).constant()),
             (SPEC_SHADING_MODE, variant.shading.constant()),
@@ -722,7 +719,7 @@ fn caustic_map(
             fewer
         );
     }
-    Ok(Some(CausticMap::new(device, gpu, scene, frame, size, &grids)?))
+    Ok(Some(CausticMap::new(device, gpu, scene, frame, size, &grids, variant.backend)?))
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ use crate::shader_interface::{
     INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, LOOKUP_EWA, LOOKUP_PROBES, SHADING_FULL, SHADING_GLOSSY_ALBEDO,
     SHADING_MIRRORED_ALBEDO, SHADING_NONE,
 };
+use crate::vk::Backend;
 
 /// How candidate boxes are intersected (`SPEC_INTERSECT_MODE`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -103,6 +104,10 @@ pub struct RenderVariant {
     pub record_path: bool,
     /// The filtered modes' texture lookup.
     pub lookup: LookupMode,
+    /// How the render pass traces rays: ray queries, or a ray-tracing
+    /// pipeline with the intersection shader. The caustic and volume passes
+    /// use ray queries.
+    pub backend: Backend,
 }
 
 impl Default for RenderVariant {
@@ -114,6 +119,7 @@ impl Default for RenderVariant {
             volume: true,
             record_path: false,
             lookup: LookupMode::Probes,
+            backend: Backend::RayQuery,
         }
     }
 }

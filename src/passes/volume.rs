@@ -9,9 +9,10 @@ use std::sync::Arc;
 
 use super::gpu::VolumePush;
 use super::scene_gpu::GpuScene;
+use super::tracer::Tracer;
 use super::IntersectMode;
 use crate::shader_interface::{BINDING_VOLUME, RENDER_GROUP, SPEC_INTERSECT_MODE};
-use crate::vk::{full_barrier, vk, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation};
+use crate::vk::{full_barrier, vk, Backend, Binding, Buffer, Commands, Device, GpuTimer, MemoryLocation};
 use crate::{shaders, RenderError};
 
 /// Camera rays per pixel in one dispatch of the volume pass.
@@ -21,7 +22,7 @@ pub const BATCH: u32 = 16;
 /// pixel. [`VolumeLight::new`] builds it for one image size;
 /// [`VolumeLight::run`] (re)computes it for the camera in the frame buffer.
 pub struct VolumeLight {
-    pipeline: ComputePipeline,
+    pipeline: Tracer,
     /// Mean in-scattered radiance per pixel (three `f32`).
     pub radiance: Buffer,
     size: (u32, u32),
@@ -30,33 +31,23 @@ pub struct VolumeLight {
 }
 
 impl VolumeLight {
-    /// Builds the pass and runs it once (see [`VolumeLight::run`]).
-    pub fn compute(
-        device: &Arc<Device>,
-        cmds: &mut Commands,
-        gpu: &GpuScene,
-        frame: &Buffer,
-        size: (u32, u32),
-        samples: u32,
-    ) -> Result<Self, RenderError> {
-        let mut pass = Self::new(device, gpu, frame, size)?;
-        pass.run(cmds, &GpuTimer::new(device)?, samples)?;
-        Ok(pass)
-    }
-
     /// Creates the pipeline and the output for a `width` x `height` image
-    /// whose frame parameters are in `frame` (`GpuFrame`); nothing runs yet.
+    /// whose frame parameters are in `frame` (`GpuFrame`), tracing with
+    /// `backend`; nothing runs yet.
     pub fn new(
         device: &Arc<Device>,
         gpu: &GpuScene,
         frame: &Buffer,
         (width, height): (u32, u32),
+        backend: Backend,
     ) -> Result<Self, RenderError> {
         let radiance =
             Buffer::storage(device, "volume radiance", width as u64 * height as u64 * 12, MemoryLocation::GpuToCpu)?;
-        let pipeline = ComputePipeline::new(
+        let pipeline = Tracer::new(
             device,
-            &shaders::volume(),
+            backend,
+            shaders::volume,
+            shaders::volume_rgen,
             &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant())],
         )?;
         let mut bindings = gpu.frame_bindings(frame);
@@ -76,11 +67,7 @@ impl VolumeLight {
             let push = VolumePush { first_sample: first, samples: BATCH.min(samples - first), total: samples };
             let ((), t) = timer.run(cmds, |d, cmd| {
                 full_barrier(d, cmd);
-                self.pipeline.dispatch(
-                    cmd,
-                    bytemuck::bytes_of(&push),
-                    [width.div_ceil(RENDER_GROUP), height.div_ceil(RENDER_GROUP), 1],
-                );
+                self.pipeline.run(cmd, bytemuck::bytes_of(&push), [width, height], [RENDER_GROUP, RENDER_GROUP]);
                 full_barrier(d, cmd);
             })?;
             seconds += t;

@@ -19,8 +19,8 @@ pub enum Backend {
     RayQuery,
     /// Ray-tracing pipelines (`VK_KHR_ray_tracing_pipeline`): ray generation,
     /// intersection and hit shaders. Some GPUs offer only these (NVIDIA GPUs
-    /// without RT cores). This build has no such backend yet: the
-    /// capabilities report it so that a user knows what a device offers.
+    /// without RT cores). Every tracing pass (render, G-buffer, caustic
+    /// rays, volume, probes) has a ray-generation shader for it.
     Pipeline,
 }
 
@@ -34,11 +34,6 @@ impl Backend {
             Backend::RayQuery => "ray-query",
             Backend::Pipeline => "pipeline",
         }
-    }
-
-    /// Whether this build can render with the backend.
-    pub fn implemented(self) -> bool {
-        matches!(self, Backend::RayQuery)
     }
 }
 
@@ -181,6 +176,10 @@ impl Capabilities {
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let compute = families.iter().find(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE));
         let ray_tracing_pipeline = has_rt && frt.ray_tracing_pipeline == vk::TRUE;
+        // QUADRAY_HIDE_RAY_QUERY=1 reports no ray queries (and the device is
+        // then created without them): a test of the pipeline backend alone,
+        // as on a GPU that offers only pipelines.
+        let hide_ray_query = std::env::var("QUADRAY_HIDE_RAY_QUERY").is_ok_and(|v| v == "1");
         let on = |flag: vk::Bool32| flag == vk::TRUE;
         Self {
             name: c_text(props.device_name_as_c_str()),
@@ -199,7 +198,7 @@ impl Capabilities {
             compute_queue: compute.is_some(),
             acceleration_structure: has_as && on(fas.acceleration_structure),
             deferred_host_operations: has(ash::khr::deferred_host_operations::NAME),
-            ray_query: has_rq && on(frq.ray_query),
+            ray_query: has_rq && on(frq.ray_query) && !hide_ray_query,
             ray_tracing_pipeline,
             buffer_device_address: on(f12.buffer_device_address),
             scalar_block_layout: on(f12.scalar_block_layout),
@@ -243,22 +242,21 @@ impl Capabilities {
     }
 
     /// The backend `--backend auto` takes: the first of [`Backend::ALL`]
-    /// that this build implements and the device has everything for.
+    /// (ray queries, then pipelines) the device has everything for.
     pub fn auto_backend(&self) -> Option<Backend> {
-        Backend::ALL.into_iter().find(|&b| b.implemented() && self.lacks(b).is_empty())
+        Backend::ALL.into_iter().find(|&b| self.lacks(b).is_empty())
     }
 
-    /// One line per backend: what the device lacks for it, or that it fits
-    /// (and whether this build implements it).
+    /// One line per backend: what the device lacks for it, or that it fits.
     pub fn backend_lines(&self) -> Vec<String> {
         Backend::ALL
             .into_iter()
             .map(|b| {
                 let lacks = self.lacks(b);
-                match (lacks.is_empty(), b.implemented()) {
-                    (true, true) => format!("{b}: supported"),
-                    (true, false) => format!("{b}: offered by the device, but this build has no {b} backend yet"),
-                    (false, _) => format!("{b}: lacks {}", lacks.join(", ")),
+                if lacks.is_empty() {
+                    format!("{b}: supported")
+                } else {
+                    format!("{b}: lacks {}", lacks.join(", "))
                 }
             })
             .collect()
@@ -282,7 +280,7 @@ pub struct Survey {
     /// What each device offers, in the order the loader lists them.
     pub devices: Vec<Capabilities>,
     /// The device `auto` takes (its index) and the backend: the most
-    /// preferred device type ([`preference`]) with an implemented backend.
+    /// preferred device type ([`preference`]) with a backend.
     pub auto: Option<(usize, Backend)>,
 }
 
@@ -348,10 +346,11 @@ mod tests {
         let caps = Capabilities { ray_query: false, ..everything() };
         assert_eq!(caps.lacks(Backend::RayQuery), ["VK_KHR_ray_query with rayQuery"]);
         assert!(caps.lacks(Backend::Pipeline).is_empty());
-        assert_eq!(caps.auto_backend(), None, "this build has no pipeline backend");
+        assert_eq!(caps.auto_backend(), Some(Backend::Pipeline));
         let lines = caps.backend_lines();
-        assert_eq!(lines[0], "ray-query: lacks VK_KHR_ray_query with rayQuery");
-        assert!(lines[1].starts_with("pipeline: offered by the device, but this build has no pipeline backend"));
+        assert_eq!(lines, ["ray-query: lacks VK_KHR_ray_query with rayQuery", "pipeline: supported"]);
+        let neither = Capabilities { ray_query: false, ray_tracing_pipeline: false, ..everything() };
+        assert_eq!(neither.auto_backend(), None);
         let no_f64 = Capabilities { float64: false, ray_tracing_pipeline: false, ..everything() };
         assert_eq!(no_f64.lacks(Backend::RayQuery), ["shaderFloat64"]);
         assert_eq!(

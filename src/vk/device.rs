@@ -8,12 +8,13 @@ use std::sync::{Arc, Mutex};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
-use super::capabilities::{preference, Backend, Capabilities};
+use super::capabilities::{preference, Capabilities, PipelineLimits};
 use super::{Instance, VkError};
 
-/// The device extensions the renderer cannot work without.
-const REQUIRED_EXTENSIONS: [&CStr; 3] =
-    [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME];
+/// The device extensions the renderer cannot work without; it also needs
+/// ray queries or ray-tracing pipelines (or both), enabled where offered.
+const REQUIRED_EXTENSIONS: [&CStr; 2] =
+    [ash::khr::acceleration_structure::NAME, ash::khr::deferred_host_operations::NAME];
 
 /// The command that installs a driver with ray queries.
 pub const SETUP_HINT: &str =
@@ -42,6 +43,13 @@ pub struct Device {
     pub max_allocation_bytes: u64,
     /// Device name, for messages.
     pub name: String,
+    /// VK_KHR_ray_tracing_pipeline entry points, when the device offers
+    /// ray-tracing pipelines (enabled then, for the pipeline backend).
+    pub ray_tracing: Option<ash::khr::ray_tracing_pipeline::Device>,
+    /// The ray-tracing-pipeline limits (zeros without pipelines).
+    pub ray_tracing_limits: PipelineLimits,
+    /// Whether ray queries are enabled (the `ray-query` backend).
+    pub ray_query: bool,
     /// The memory allocator (dropped before the device).
     pub allocator: ManuallyDrop<Mutex<Allocator>>,
 }
@@ -77,8 +85,9 @@ fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
 }
 
 impl Device {
-    /// Picks the first physical device with ray queries (preferring discrete
-    /// GPUs, then integrated, then software) and creates a logical device.
+    /// Picks the first physical device with ray queries or ray-tracing
+    /// pipelines (preferring discrete GPUs, then integrated, then software)
+    /// and creates a logical device with what it offers of both.
     /// When none fits, the error lists every device seen and what it lacks.
     pub fn new(instance: Arc<Instance>) -> Result<Arc<Self>, VkError> {
         Self::select(instance, &|_, _| Vec::new(), false)
@@ -92,7 +101,7 @@ impl Device {
         Self::select(instance, &|raw, pd| surface_shortcomings(raw, pd, surface), true)
     }
 
-    /// The device that fits best: ray queries and `more` lacks nothing;
+    /// The device that fits best: it has a backend and `more` lacks nothing;
     /// `swapchain` enables VK_KHR_swapchain.
     fn select(
         instance: Arc<Instance>,
@@ -108,26 +117,20 @@ impl Device {
         for &pd in &devices {
             let props = unsafe { raw_instance.get_physical_device_properties(pd) };
             let caps = Capabilities::query(raw_instance, pd);
-            let mut missing: Vec<String> = caps.lacks(Backend::RayQuery).into_iter().map(String::from).collect();
-            missing.extend(more(raw_instance, pd));
-            if missing.is_empty() {
-                fits.push((preference(props.device_type), pd));
-                report.push(format!("  {}: suitable", caps.name));
-            } else {
-                // Per backend: what the device lacks for each, so that a GPU
-                // with ray-tracing pipelines but no ray queries is told apart
-                // from one that lacks float64.
-                let mut lines = caps.backend_lines();
-                if caps.lacks(Backend::RayQuery).is_empty() {
-                    lines[0] = format!("{}: lacks {}", Backend::RayQuery, missing.join(", "));
+            let extra = more(raw_instance, pd);
+            match caps.auto_backend() {
+                Some(backend) if extra.is_empty() => {
+                    fits.push((preference(props.device_type), pd));
+                    report.push(format!("  {}: suitable ({backend} backend)", caps.name));
                 }
-                report.push(format!(
-                    "  {} ({}):
-    {}",
+                Some(_) => report.push(format!("  {}: lacks {}", caps.name, extra.join(", "))),
+                // Per backend: what the device lacks for each.
+                None => report.push(format!(
+                    "  {} ({}):\n    {}",
                     caps.name,
                     caps.device_type,
-                    lines.join("\n    ")
-                ));
+                    caps.backend_lines().join("\n    ")
+                )),
             }
         }
         let Some(&(_, physical)) = fits.iter().min_by_key(|(rank, _)| *rank) else {
@@ -151,6 +154,14 @@ impl Device {
         if swapchain {
             ext_names.push(ash::khr::swapchain::NAME.as_ptr());
         }
+        // Ray queries and ray-tracing pipelines where offered: the backends.
+        let caps = Capabilities::query(raw_instance, physical);
+        if caps.ray_query {
+            ext_names.push(ash::khr::ray_query::NAME.as_ptr());
+        }
+        if caps.ray_tracing_pipeline {
+            ext_names.push(ash::khr::ray_tracing_pipeline::NAME.as_ptr());
+        }
 
         let mut supported12 = vk::PhysicalDeviceVulkan12Features::default();
         let mut supported = vk::PhysicalDeviceFeatures2::default().push_next(&mut supported12);
@@ -165,11 +176,15 @@ impl Device {
             .shader_buffer_int64_atomics(true);
         let mut fas = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
         let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
-        let mut features = vk::PhysicalDeviceFeatures2::default()
-            .features(base_features)
-            .push_next(&mut f12)
-            .push_next(&mut fas)
-            .push_next(&mut frq);
+        let mut frt = vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default().ray_tracing_pipeline(true);
+        let mut features =
+            vk::PhysicalDeviceFeatures2::default().features(base_features).push_next(&mut f12).push_next(&mut fas);
+        if caps.ray_query {
+            features = features.push_next(&mut frq);
+        }
+        if caps.ray_tracing_pipeline {
+            features = features.push_next(&mut frt);
+        }
         let info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_extension_names(&ext_names)
@@ -177,6 +192,15 @@ impl Device {
         let raw = unsafe { raw_instance.create_device(physical, &info, None) }?;
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
         let accel = ash::khr::acceleration_structure::Device::new(raw_instance, &raw);
+        let ray_tracing =
+            caps.ray_tracing_pipeline.then(|| ash::khr::ray_tracing_pipeline::Device::new(raw_instance, &raw));
+        let ray_tracing_limits = caps.pipeline_limits.unwrap_or(PipelineLimits {
+            shader_group_handle_size: 0,
+            shader_group_handle_alignment: 0,
+            shader_group_base_alignment: 0,
+            max_ray_recursion_depth: 0,
+            max_ray_hit_attribute_size: 0,
+        });
 
         let mut as_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
         let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
@@ -209,6 +233,9 @@ impl Device {
             accel_properties,
             max_allocation_bytes: maintenance3.max_memory_allocation_size,
             name,
+            ray_tracing,
+            ray_tracing_limits,
+            ray_query: caps.ray_query,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
         }))
     }

@@ -12,6 +12,7 @@ mod image;
 mod instance;
 mod pipeline;
 pub mod reflect;
+mod rt_pipeline;
 mod sampler;
 #[cfg(feature = "viewer")]
 mod surface;
@@ -30,7 +31,8 @@ pub use device::{Device, SETUP_HINT};
 pub use gpu_allocator::MemoryLocation;
 pub use image::Image;
 pub use instance::{Instance, ValidationCounters};
-pub use pipeline::{Binding, BindingKind, ComputePipeline};
+pub use pipeline::{Binding, BindingKind, ComputePipeline, PipelineResources};
+pub use rt_pipeline::{RayTracingPipeline, RayTracingStages};
 pub use sampler::Sampler;
 #[cfg(feature = "viewer")]
 pub use surface::{surface_extensions, Surface};

@@ -1,4 +1,5 @@
-//! Compute pipelines with one descriptor set and a push-constant block.
+//! Compute pipelines with one descriptor set and a push-constant block, and
+//! the layout and descriptor set every pipeline kind shares.
 
 use std::sync::Arc;
 
@@ -64,30 +65,36 @@ impl Binding<'_> {
     }
 }
 
-/// A compute pipeline, its layout, and one descriptor set, all built from
-/// the shader's reflected interface ([`ShaderInterface`]).
-pub struct ComputePipeline {
+/// A pipeline's layout and its one descriptor set, built from the reflected
+/// interface of its stages ([`ShaderInterface`]); compute and ray-tracing
+/// pipelines share it.
+pub struct PipelineResources {
     device: Arc<Device>,
-    /// The pipeline.
-    pub raw: vk::Pipeline,
     /// The pipeline layout.
     pub layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
     pool: vk::DescriptorPool,
     /// The descriptor set.
     pub set: vk::DescriptorSet,
-    /// The shader's interface: bindings, spec constants, push constants.
+    /// The stages' interface: bindings, spec constants, push constants.
     pub interface: ShaderInterface,
+    /// The stages the bindings and push constants are visible to.
+    pub stages: vk::ShaderStageFlags,
 }
 
-impl ComputePipeline {
-    /// Creates the pipeline from SPIR-V words: its descriptor set layout and
-    /// push-constant range are those the shader declares, and
-    /// `specialization` sets constants by their ids (`SPEC_*` of
-    /// `shader_interface`); an id the shader lacks is an error.
-    pub fn new(device: &Arc<Device>, spirv: &[u32], specialization: &[(u32, u32)]) -> Result<Self, VkError> {
-        let interface = ShaderInterface::reflect(spirv)?;
-        interface.check_spec_constants(specialization.iter().map(|&(id, _)| id))?;
+impl PipelineResources {
+    /// The device.
+    pub fn device(&self) -> &Arc<Device> {
+        &self.device
+    }
+
+    /// The set layout (every binding visible to `stages`), the push-constant
+    /// range and the pipeline layout of `interface`, and its descriptor set.
+    pub fn new(
+        device: &Arc<Device>,
+        interface: ShaderInterface,
+        stages: vk::ShaderStageFlags,
+    ) -> Result<Self, VkError> {
         let raw = &device.raw;
         let layout_bindings: Vec<_> = interface
             .bindings
@@ -97,18 +104,18 @@ impl ComputePipeline {
                     .binding(i)
                     .descriptor_type(b.kind.descriptor_type())
                     .descriptor_count(b.kind.count())
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+                    .stage_flags(stages)
             })
             .collect();
         let push_constant_size = interface.push_constant_size;
         let mut this = Self {
             device: device.clone(),
-            raw: vk::Pipeline::null(),
             layout: vk::PipelineLayout::null(),
             set_layout: vk::DescriptorSetLayout::null(),
             pool: vk::DescriptorPool::null(),
             set: vk::DescriptorSet::null(),
             interface,
+            stages,
         };
         // From here on, `this` owns what is created and Drop cleans up on error.
         this.set_layout = unsafe {
@@ -117,36 +124,13 @@ impl ComputePipeline {
                 None,
             )
         }?;
-        let ranges = [vk::PushConstantRange::default()
-            .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            .offset(0)
-            .size(push_constant_size)];
+        let ranges = [vk::PushConstantRange::default().stage_flags(stages).offset(0).size(push_constant_size)];
         let set_layouts = [this.set_layout];
         let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
         if push_constant_size > 0 {
             layout_info = layout_info.push_constant_ranges(&ranges);
         }
         this.layout = unsafe { raw.create_pipeline_layout(&layout_info, None) }?;
-
-        let module = unsafe { raw.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(spirv), None) }?;
-        let entries: Vec<_> = specialization
-            .iter()
-            .enumerate()
-            .map(|(i, &(id, _))| vk::SpecializationMapEntry { constant_id: id, offset: 4 * i as u32, size: 4 })
-            .collect();
-        let values: Vec<u32> = specialization.iter().map(|&(_, v)| v).collect();
-        let spec_data: &[u8] = bytemuck::cast_slice(&values);
-        let spec = vk::SpecializationInfo::default().map_entries(&entries).data(spec_data);
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
-            .name(c"main")
-            .specialization_info(&spec);
-        let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(this.layout)];
-        let created = unsafe { raw.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
-        unsafe { raw.destroy_shader_module(module, None) };
-        this.raw = created.map_err(|(_, e)| e)?[0];
-
         let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
         for b in this.interface.bindings.values() {
             let ty = b.kind.descriptor_type();
@@ -169,6 +153,44 @@ impl ComputePipeline {
             }?[0];
         }
         Ok(this)
+    }
+
+    /// The specialisation info of `specialization` (id, value) pairs; an id
+    /// no stage declares is an error. `entries` and `values` hold the data.
+    pub(super) fn specialization<'a>(
+        &self,
+        specialization: &[(u32, u32)],
+        entries: &'a mut Vec<vk::SpecializationMapEntry>,
+        values: &'a mut Vec<u32>,
+    ) -> Result<vk::SpecializationInfo<'a>, VkError> {
+        self.interface.check_spec_constants(specialization.iter().map(|&(id, _)| id))?;
+        *entries = specialization
+            .iter()
+            .enumerate()
+            .map(|(i, &(id, _))| vk::SpecializationMapEntry { constant_id: id, offset: 4 * i as u32, size: 4 })
+            .collect();
+        *values = specialization.iter().map(|&(_, v)| v).collect();
+        Ok(vk::SpecializationInfo::default().map_entries(entries).data(bytemuck::cast_slice(values)))
+    }
+
+    /// Records binding the set at `bind_point` and pushing `constants`
+    /// (exactly the stages' push-constant block).
+    pub(super) fn record(&self, cmd: vk::CommandBuffer, bind_point: vk::PipelineBindPoint, constants: &[u8]) {
+        assert_eq!(
+            constants.len(),
+            self.interface.push_constant_size as usize,
+            "{}",
+            InterfaceError::PushConstants { host: constants.len() as u32, shader: self.interface.push_constant_size }
+        );
+        let raw = &self.device.raw;
+        unsafe {
+            if self.set != vk::DescriptorSet::null() {
+                raw.cmd_bind_descriptor_sets(cmd, bind_point, self.layout, 0, &[self.set], &[]);
+            }
+            if !constants.is_empty() {
+                raw.cmd_push_constants(cmd, self.layout, self.stages, 0, constants);
+            }
+        }
     }
 
     /// Points the shader's bindings at resources given by binding number
@@ -244,38 +266,71 @@ impl ComputePipeline {
         unsafe { self.device.raw.update_descriptor_sets(&writes, &[]) };
         Ok(())
     }
+}
+
+impl Drop for PipelineResources {
+    fn drop(&mut self) {
+        let raw = &self.device.raw;
+        unsafe {
+            raw.destroy_descriptor_pool(self.pool, None);
+            raw.destroy_pipeline_layout(self.layout, None);
+            raw.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// A compute pipeline with its layout and one descriptor set, all built
+/// from the shader's reflected interface ([`ShaderInterface`]).
+pub struct ComputePipeline {
+    /// The layout, descriptor set and interface.
+    pub resources: PipelineResources,
+    /// The pipeline.
+    pub raw: vk::Pipeline,
+    /// The shader's interface: bindings, spec constants, push constants.
+    pub interface: ShaderInterface,
+}
+
+impl ComputePipeline {
+    /// Creates the pipeline from SPIR-V words: its descriptor set layout and
+    /// push-constant range are those the shader declares, and
+    /// `specialization` sets constants by their ids (`SPEC_*` of
+    /// `shader_interface`); an id the shader lacks is an error.
+    pub fn new(device: &Arc<Device>, spirv: &[u32], specialization: &[(u32, u32)]) -> Result<Self, VkError> {
+        let interface = ShaderInterface::reflect(spirv)?;
+        let resources = PipelineResources::new(device, interface.clone(), vk::ShaderStageFlags::COMPUTE)?;
+        let (mut entries, mut values) = (Vec::new(), Vec::new());
+        let spec = resources.specialization(specialization, &mut entries, &mut values)?;
+        let raw = &device.raw;
+        let module = unsafe { raw.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(spirv), None) }?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main")
+            .specialization_info(&spec);
+        let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(resources.layout)];
+        let created = unsafe { raw.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
+        unsafe { raw.destroy_shader_module(module, None) };
+        let pipeline = created.map_err(|(_, e)| e)?[0];
+        Ok(Self { resources, raw: pipeline, interface })
+    }
+
+    /// Points the shader's bindings at resources ([`PipelineResources::bind`]).
+    pub fn bind(&self, resources: &[(u32, Binding<'_>)]) -> Result<(), VkError> {
+        self.resources.bind(resources)
+    }
 
     /// Records binding the pipeline and set, pushing `constants` (exactly
     /// the shader's push-constant block), and a dispatch.
     pub fn dispatch(&self, cmd: vk::CommandBuffer, constants: &[u8], groups: [u32; 3]) {
-        assert_eq!(
-            constants.len(),
-            self.interface.push_constant_size as usize,
-            "{}",
-            InterfaceError::PushConstants { host: constants.len() as u32, shader: self.interface.push_constant_size }
-        );
-        let raw = &self.device.raw;
-        unsafe {
-            raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw);
-            if self.set != vk::DescriptorSet::null() {
-                raw.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[self.set], &[]);
-            }
-            if !constants.is_empty() {
-                raw.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, constants);
-            }
-            raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]);
-        }
+        let raw = &self.resources.device.raw;
+        unsafe { raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw) };
+        self.resources.record(cmd, vk::PipelineBindPoint::COMPUTE, constants);
+        unsafe { raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 }
 
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
-        let raw = &self.device.raw;
-        unsafe {
-            raw.destroy_descriptor_pool(self.pool, None);
-            raw.destroy_pipeline(self.raw, None);
-            raw.destroy_pipeline_layout(self.layout, None);
-            raw.destroy_descriptor_set_layout(self.set_layout, None);
-        }
+        unsafe { self.resources.device.raw.destroy_pipeline(self.raw, None) };
     }
 }

@@ -208,6 +208,32 @@ impl ShaderInterface {
         Ok(this)
     }
 
+    /// The interface of a pipeline of several stages: the union of their
+    /// bindings (a binding number two stages declare must hold the same
+    /// kind), spec constants, structs, and the largest push-constant block.
+    pub fn merge(mut self, other: ShaderInterface) -> Result<Self, InterfaceError> {
+        for (binding, b) in other.bindings {
+            match self.bindings.get(&binding) {
+                Some(mine) if mine.kind != b.kind => {
+                    return Err(InterfaceError::Mismatch {
+                        binding,
+                        name: mine.name.clone(),
+                        shader: mine.kind,
+                        host: format!("{:?} in another stage ({})", b.kind, b.name),
+                    })
+                }
+                Some(_) => {}
+                None => {
+                    self.bindings.insert(binding, b);
+                }
+            }
+        }
+        self.spec_constants.extend(other.spec_constants);
+        self.structs.extend(other.structs);
+        self.push_constant_size = self.push_constant_size.max(other.push_constant_size);
+        Ok(self)
+    }
+
     /// Checks the host's specialisation constant ids against the shader's.
     pub fn check_spec_constants(&self, ids: impl IntoIterator<Item = u32>) -> Result<(), InterfaceError> {
         for id in ids {

@@ -679,3 +679,37 @@ fn devices_lists_the_drivers_capabilities_and_the_backend_auto_takes() {
     assert!(text.contains("auto: device "), "{text}");
     assert!(entries(dir.path()).is_empty(), "devices writes nothing");
 }
+
+/// A device without ray queries (simulated: `QUADRAY_HIDE_RAY_QUERY=1`
+/// creates lavapipe without them, as a GPU that offers only ray-tracing
+/// pipelines) renders every pass through the pipeline, under the validation
+/// layer, to the same image as the ray-query backend; `--backend ray-query`
+/// is then refused with a message that names the way out.
+#[test]
+fn without_ray_queries_every_pass_runs_through_the_pipeline() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/tests/lens_fog.toml");
+    let size = ["--width", "48", "--height", "36", "--spp", "2", "--validation"];
+    let hidden = [("QUADRAY_HIDE_RAY_QUERY", "1")];
+    let devices = quadray(&["devices"], dir.path(), &hidden);
+    let text = String::from_utf8_lossy(&devices.stdout);
+    assert!(text.contains("backend ray-query: lacks VK_KHR_ray_query"), "{text}");
+    assert!(text.contains("with the pipeline backend"), "{text}");
+    let pipeline: Vec<&str> = ["render", scene, "-o", "pipeline.exr"].into_iter().chain(size).collect();
+    let stderr = render_ok(&pipeline, dir.path(), &hidden);
+    assert!(stderr.contains("caustics:") && stderr.contains("volume:"), "the caustic and volume passes ran: {stderr}");
+    let reference: Vec<&str> =
+        ["render", scene, "-o", "rq.exr", "--backend", "ray-query"].into_iter().chain(size).collect();
+    render_ok(&reference, dir.path(), &[]);
+    let read = |name: &str| quadray::output::read_render_exr(&dir.path().join(name)).unwrap().output;
+    let (a, b) = (read("rq.exr"), read("pipeline.exr"));
+    let flip = quadray::metrics::flip_mean(&a, &b, 0.0).unwrap();
+    println!("lens_fog without ray queries against ray queries: FLIP {flip:.6}");
+    assert!(flip <= 0.001, "FLIP {flip}");
+    let refused: Vec<&str> =
+        ["render", scene, "-o", "no.exr", "--backend", "ray-query"].into_iter().chain(size).collect();
+    let out = quadray(&refused, dir.path(), &hidden);
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && message.contains("offers no ray queries"), "{message}");
+    assert!(!dir.path().join("no.exr").exists());
+}

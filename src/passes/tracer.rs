@@ -1,0 +1,68 @@
+//! How a pass traces rays, one of two backends: a compute shader with ray
+//! queries (`VK_KHR_ray_query`), or a ray-tracing pipeline whose
+//! intersection shader solves the perturbed quadric's first root in each
+//! candidate box (`VK_KHR_ray_tracing_pipeline`; GPUs without RT cores offer
+//! only these). Both run the same GLSL: the pass's body is an include that
+//! `NAME.comp` and `NAME.rgen` call.
+
+use std::sync::Arc;
+
+use crate::shaders;
+use crate::vk::{vk, Backend, Binding, ComputePipeline, Device, RayTracingPipeline, RayTracingStages, VkError};
+
+/// A pass's shader on one backend.
+pub enum Tracer {
+    /// Ray queries in a compute shader.
+    RayQuery(ComputePipeline),
+    /// A ray-tracing pipeline.
+    Pipeline(RayTracingPipeline),
+}
+
+impl Tracer {
+    /// The pass's pipeline for `backend`: the compute shader `compute`, or
+    /// the ray-generation shader `raygen` with the shared miss,
+    /// intersection and closest-hit stages; `specialization` as
+    /// [`ComputePipeline::new`]. On a device without ray queries every pass
+    /// takes the pipeline.
+    pub fn new(
+        device: &Arc<Device>,
+        backend: Backend,
+        compute: fn() -> Vec<u32>,
+        raygen: fn() -> Vec<u32>,
+        specialization: &[(u32, u32)],
+    ) -> Result<Self, VkError> {
+        let backend = if device.ray_query { backend } else { Backend::Pipeline };
+        Ok(match backend {
+            Backend::RayQuery => Tracer::RayQuery(ComputePipeline::new(device, &compute(), specialization)?),
+            Backend::Pipeline => {
+                let stages = RayTracingStages {
+                    raygen: raygen(),
+                    miss: shaders::miss_rmiss(),
+                    intersection: shaders::intersect_rint(),
+                    closest_hit: shaders::closest_hit_rchit(),
+                };
+                Tracer::Pipeline(RayTracingPipeline::new(device, &stages, specialization)?)
+            }
+        })
+    }
+
+    /// Points the shader's bindings at resources.
+    pub fn bind(&self, resources: &[(u32, Binding<'_>)]) -> Result<(), VkError> {
+        match self {
+            Tracer::RayQuery(p) => p.bind(resources),
+            Tracer::Pipeline(p) => p.bind(resources),
+        }
+    }
+
+    /// Records `size` = (width, height) invocations with push `constants`:
+    /// workgroups of `group` invocations a side (rounded up) on ray
+    /// queries, one launch each on the pipeline.
+    pub fn run(&self, cmd: vk::CommandBuffer, constants: &[u8], size: [u32; 2], group: [u32; 2]) {
+        match self {
+            Tracer::RayQuery(p) => {
+                p.dispatch(cmd, constants, [size[0].div_ceil(group[0]), size[1].div_ceil(group[1]), 1])
+            }
+            Tracer::Pipeline(p) => p.trace(cmd, constants, [size[0], size[1], 1]),
+        }
+    }
+}
