@@ -76,6 +76,9 @@ pub struct Config {
     pub binary: PathBuf,
     /// An older binary to measure beside it.
     pub baseline: Option<PathBuf>,
+    /// Measure the new binary with each backend (`--backend ray-query`,
+    /// then `--backend pipeline`) side by side instead of beside a baseline.
+    pub backends: bool,
     /// Samples per pixel of a reference (rendered once per scene by the new
     /// binary, cached in `out_dir/cache`); none: no reference.
     pub reference_spp: Option<u32>,
@@ -102,7 +105,8 @@ pub struct Run {
 /// One binary on one scene.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BinaryResult {
-    /// "new" or "baseline".
+    /// "new" or "baseline"; "ray-query" or "pipeline" when the backends are
+    /// compared.
     pub binary: String,
     /// Its path.
     pub path: String,
@@ -129,7 +133,8 @@ pub struct SceneResult {
     pub scene: String,
     /// The new binary, then the baseline if any.
     pub binaries: Vec<BinaryResult>,
-    /// Median over runs of new samples/s ÷ baseline samples/s.
+    /// Median over runs of the first's samples/s ÷ the second's (new ÷
+    /// baseline, or ray-query ÷ pipeline).
     pub speedup: Option<f64>,
     /// True when the last images of both binaries are the same bit for bit.
     pub identical: Option<bool>,
@@ -261,23 +266,31 @@ pub fn run(config: &Config) -> Result<Report, ThroughputError> {
         config.spp.to_string(),
     ];
     let warm_flags: Vec<String> = ["--width", "64", "--height", "48", "--spp", "1"].map(String::from).to_vec();
-    let mut binaries = vec![("new", config.binary.clone())];
+    // What is measured: (name, binary, extra flags).
+    let mut binaries: Vec<(&str, PathBuf, Vec<String>)> = if config.backends {
+        ["ray-query", "pipeline"]
+            .map(|b| (b, config.binary.clone(), vec!["--backend".to_string(), b.to_string()]))
+            .to_vec()
+    } else {
+        vec![("new", config.binary.clone(), Vec::new())]
+    };
     if let Some(b) = &config.baseline {
-        binaries.push(("baseline", b.clone()));
+        binaries.push(("baseline", b.clone(), Vec::new()));
     }
+    let with = |base: &[String], extra: &[String]| -> Vec<String> { base.iter().chain(extra).cloned().collect() };
     let samples = w as f64 * h as f64 * config.spp as f64;
     let mut scenes = Vec::new();
     for scene in &config.scenes {
         let stem = scene_stem(scene);
         let output = |name: &str| images.join(format!("{stem}-{name}.exr"));
-        for (name, bin) in &binaries {
+        for (name, bin, extra) in &binaries {
             eprintln!("{stem}: warming up {name} (shader compilation)");
-            render(config, bin, scene, &warm_flags, &images.join(format!("{stem}-{name}-warm.exr")))?;
+            render(config, bin, scene, &with(&warm_flags, extra), &images.join(format!("{stem}-{name}-warm.exr")))?;
         }
         let mut runs: Vec<Vec<Run>> = vec![Vec::new(); binaries.len()];
         for r in 0..config.runs {
-            for (i, (name, bin)) in binaries.iter().enumerate() {
-                let run = render(config, bin, scene, &flags, &output(name))?;
+            for (i, (name, bin, extra)) in binaries.iter().enumerate() {
+                let run = render(config, bin, scene, &with(&flags, extra), &output(name))?;
                 eprintln!(
                     "{stem}: {name} run {}/{}: {:.0} samples/s, {:.2} s GPU, {:.2} s wall, {:.0} % CPU",
                     r + 1,
@@ -318,7 +331,7 @@ pub fn run(config: &Config) -> Result<Report, ThroughputError> {
             None => None,
         };
         let mut results = Vec::new();
-        for (i, (name, bin)) in binaries.iter().enumerate() {
+        for (i, (name, bin, _)) in binaries.iter().enumerate() {
             let image = read_exr(&output(name))?;
             let (rel, flip) = match &reference {
                 Some(r) => (Some(relative_mse(r, &image)?), Some(flip_mean(r, &image, 0.0)?)),
@@ -339,7 +352,7 @@ pub fn run(config: &Config) -> Result<Report, ThroughputError> {
         }
         let (speedup, identical, between) = if binaries.len() == 2 {
             let ratios = runs[0].iter().zip(&runs[1]).map(|(a, b)| b.gpu_seconds / a.gpu_seconds).collect();
-            let (a, b) = (read_exr(&output("new"))?, read_exr(&output("baseline"))?);
+            let (a, b) = (read_exr(&output(binaries[0].0))?, read_exr(&output(binaries[1].0))?);
             (Some(median(ratios)), Some(a.radiance == b.radiance), Some(relative_mse(&b, &a)?))
         } else {
             (None, None, None)
@@ -385,8 +398,8 @@ pub fn markdown(report: &Report) -> String {
     s += "|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n";
     let opt = |v: Option<f64>, digits: usize| v.map_or("–".to_string(), |v| format!("{v:.digits$}"));
     for sc in &report.scenes {
-        for b in &sc.binaries {
-            let is_new = b.binary == "new";
+        for (i, b) in sc.binaries.iter().enumerate() {
+            let is_new = i == 0;
             let images = match (is_new, sc.identical, sc.relative_mse_between) {
                 (true, Some(true), _) => "identical".to_string(),
                 (true, Some(false), Some(r)) => format!("differ (relMSE {r:.2e})"),

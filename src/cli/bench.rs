@@ -21,8 +21,13 @@ pub(crate) struct ThroughputArgs {
     #[arg(default_values = ["default", "scenes/figure1_left.toml", "scenes/glass_vessel.toml", "scenes/spheres.toml"])]
     pub(crate) scenes: Vec<String>,
     /// An older quadray binary to measure beside this one, run for run.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "backends")]
     pub(crate) baseline: Option<PathBuf>,
+    /// Measure this binary with each backend side by side (`--backend
+    /// ray-query`, then `--backend pipeline`, run for run) instead of beside
+    /// a baseline.
+    #[arg(long)]
+    pub(crate) backends: bool,
     /// Image width of the timed renders.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) width: u32,
@@ -296,6 +301,7 @@ pub(crate) fn throughput(args: ThroughputArgs, set_threads: bool) -> Result<()> 
         runs: args.runs,
         binary: std::env::current_exe().context("cannot find this binary's path")?,
         baseline: args.baseline,
+        backends: args.backends,
         reference_spp: args.reference_spp,
         out_dir: args.out.clone(),
         // Each binary picks its own lavapipe thread count, as it would alone.

@@ -319,6 +319,7 @@ pub(crate) fn bench(
     backend: quadray::vk::Backend,
 ) -> Result<quadray::passes::RenderOutput> {
     use quadray::passes::{render, GpuScene, RenderVariant};
+    use quadray::vk::Backend;
 
     let device = &ctx.device;
     let mut cmds = quadray::vk::Commands::new(device)?;
@@ -381,6 +382,16 @@ pub(crate) fn bench(
     for (name, seconds, rate) in &rows {
         eprintln!("{name:<46} {seconds:>9.3} {rate:>14.0} {:>11.1}%", 100.0 * seconds / full_seconds);
     }
+    // The full render on every backend the device offers, side by side.
+    let mut by_backend = vec![(backend, rows[0].2)];
+    for other in Backend::ALL.into_iter().filter(|&b| b != backend && device.offers(b)) {
+        let variant = RenderVariant { backend: other, ..variants[0].1 };
+        quadray::passes::Renderer::warm_up(device, &mut cmds, &gpu, scene, variant)?;
+        let out = render(device, &mut cmds, &gpu, scene, variant, &mut |_, _| {})?;
+        by_backend.push((other, im.width as f64 * im.height as f64 * im.spp as f64 / out.seconds));
+    }
+    let line: Vec<String> = by_backend.iter().map(|(b, rate)| format!("{b} {rate:.0}")).collect();
+    eprintln!("full render, samples/s by backend: {}", line.join(", "));
     let full = full.expect("the full render");
     print_frame_table(&full, rows[2].1, im.spp);
     Ok(full)

@@ -179,7 +179,10 @@ impl Capabilities {
         // QUADRAY_HIDE_RAY_QUERY=1 reports no ray queries (and the device is
         // then created without them): a test of the pipeline backend alone,
         // as on a GPU that offers only pipelines.
-        let hide_ray_query = std::env::var("QUADRAY_HIDE_RAY_QUERY").is_ok_and(|v| v == "1");
+        let hidden = |name: &str| std::env::var(name).is_ok_and(|v| v == "1");
+        let hide_ray_query = hidden("QUADRAY_HIDE_RAY_QUERY");
+        // QUADRAY_HIDE_PIPELINE=1 likewise hides ray-tracing pipelines.
+        let ray_tracing_pipeline = ray_tracing_pipeline && !hidden("QUADRAY_HIDE_PIPELINE");
         let on = |flag: vk::Bool32| flag == vk::TRUE;
         Self {
             name: c_text(props.device_name_as_c_str()),

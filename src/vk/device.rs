@@ -240,6 +240,14 @@ impl Device {
         }))
     }
 
+    /// Whether the device was created with what `backend` needs.
+    pub fn offers(&self, backend: super::Backend) -> bool {
+        match backend {
+            super::Backend::RayQuery => self.ray_query,
+            super::Backend::Pipeline => self.ray_tracing.is_some(),
+        }
+    }
+
     /// Nanoseconds per timestamp tick.
     pub fn timestamp_period_ns(&self) -> f64 {
         self.properties.limits.timestamp_period as f64

@@ -50,7 +50,7 @@ pub enum VkError {
     #[error("the Khronos validation layer is not installed (package vulkan-validationlayers). To fix: {SETUP_HINT}")]
     MissingValidationLayer,
     /// No device has what the renderer needs.
-    #[error("no Vulkan device supports ray queries; {0}")]
+    #[error("no Vulkan device can trace rays (ray queries or ray-tracing pipelines); {0}")]
     NoSuitableDevice(String),
     /// Memory allocation failed.
     #[error("GPU memory allocation failed: {0}")]

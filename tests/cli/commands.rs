@@ -554,7 +554,7 @@ fn without_a_vulkan_driver_the_error_says_how_to_install_one() {
     let out = quadray(&["render", "-o", "x"], outdir.path(), &[("VK_ICD_FILENAMES", "/nonexistent/icd.json")]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
-    assert!(stderr.contains("no Vulkan device supports ray queries"), "{stderr}");
+    assert!(stderr.contains("no Vulkan device can trace rays"), "{stderr}");
     assert!(stderr.contains("make setup"), "{stderr}");
     assert!(entries(outdir.path()).is_empty());
 }
@@ -712,4 +712,32 @@ fn without_ray_queries_every_pass_runs_through_the_pipeline() {
     let message = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && message.contains("offers no ray queries"), "{message}");
     assert!(!dir.path().join("no.exr").exists());
+}
+
+/// A device with neither ray queries nor ray-tracing pipelines (both masked:
+/// `QUADRAY_HIDE_RAY_QUERY=1 QUADRAY_HIDE_PIPELINE=1`) is refused: the
+/// error lists every device with what it lacks per backend and the setup
+/// command, and writes nothing; `devices` says no device fits.
+#[test]
+fn a_device_with_neither_extension_is_refused_with_what_it_lacks() {
+    let dir = tempfile::tempdir().unwrap();
+    let masked = [("QUADRAY_HIDE_RAY_QUERY", "1"), ("QUADRAY_HIDE_PIPELINE", "1")];
+    let out = quadray(&["render", "-o", "none.png"], dir.path(), &masked);
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{message}");
+    for needle in [
+        "no Vulkan device can trace rays",
+        "llvmpipe",
+        "ray-query: lacks VK_KHR_ray_query with rayQuery",
+        "pipeline: lacks VK_KHR_ray_tracing_pipeline with rayTracingPipeline",
+        "make setup",
+    ] {
+        assert!(message.contains(needle), "`{needle}` missing from:\n{message}");
+    }
+    println!("{message}");
+    assert!(entries(dir.path()).is_empty(), "nothing is written");
+    let devices = quadray(&["devices"], dir.path(), &masked);
+    assert!(devices.status.success());
+    let text = String::from_utf8_lossy(&devices.stdout);
+    assert!(text.contains("auto: no device fits"), "{text}");
 }
