@@ -174,15 +174,15 @@ impl BackendChoice {
     pub(crate) fn resolve(self, device: &quadray::vk::Device) -> Result<quadray::vk::Backend> {
         use quadray::vk::Backend;
         match self {
-            BackendChoice::Auto if device.ray_query => Ok(Backend::RayQuery),
+            BackendChoice::Auto if device.offers(Backend::RayQuery) => Ok(Backend::RayQuery),
             BackendChoice::Auto => Ok(Backend::Pipeline),
-            BackendChoice::RayQuery if device.ray_query => Ok(Backend::RayQuery),
+            BackendChoice::RayQuery if device.offers(Backend::RayQuery) => Ok(Backend::RayQuery),
             BackendChoice::RayQuery => anyhow::bail!(
                 "{} offers no ray queries (VK_KHR_ray_query); `--backend pipeline` traces through ray-tracing \
                  pipelines instead",
                 device.name
             ),
-            BackendChoice::Pipeline if device.ray_tracing.is_some() => Ok(Backend::Pipeline),
+            BackendChoice::Pipeline if device.offers(Backend::Pipeline) => Ok(Backend::Pipeline),
             BackendChoice::Pipeline => anyhow::bail!(
                 "{} offers no ray-tracing pipelines (VK_KHR_ray_tracing_pipeline); `quadray devices` lists what \
                  each device offers",

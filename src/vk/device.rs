@@ -43,15 +43,21 @@ pub struct Device {
     pub max_allocation_bytes: u64,
     /// Device name, for messages.
     pub name: String,
-    /// VK_KHR_ray_tracing_pipeline entry points, when the device offers
-    /// ray-tracing pipelines (enabled then, for the pipeline backend).
-    pub ray_tracing: Option<ash::khr::ray_tracing_pipeline::Device>,
-    /// The ray-tracing-pipeline limits (zeros without pipelines).
-    pub ray_tracing_limits: PipelineLimits,
+    /// Ray-tracing pipelines, when the device offers them (enabled then,
+    /// for the pipeline backend).
+    pub ray_tracing: Option<RayTracing>,
     /// Whether ray queries are enabled (the `ray-query` backend).
     pub ray_query: bool,
     /// The memory allocator (dropped before the device).
     pub allocator: ManuallyDrop<Mutex<Allocator>>,
+}
+
+/// VK_KHR_ray_tracing_pipeline on a device: its entry points and limits.
+pub struct RayTracing {
+    /// The entry points.
+    pub loader: ash::khr::ray_tracing_pipeline::Device,
+    /// The limits a shader binding table is laid out by.
+    pub limits: PipelineLimits,
 }
 
 /// The acceleration-structure limits the renderer uses.
@@ -120,7 +126,7 @@ impl Device {
             let extra = more(raw_instance, pd);
             match caps.auto_backend() {
                 Some(backend) if extra.is_empty() => {
-                    fits.push((preference(props.device_type), pd));
+                    fits.push((preference(props.device_type), pd, caps.clone()));
                     report.push(format!("  {}: suitable ({backend} backend)", caps.name));
                 }
                 Some(_) => report.push(format!("  {}: lacks {}", caps.name, extra.join(", "))),
@@ -133,14 +139,21 @@ impl Device {
                 )),
             }
         }
-        let Some(&(_, physical)) = fits.iter().min_by_key(|(rank, _)| *rank) else {
+        let Some((_, physical, caps)) = fits.into_iter().min_by_key(|(rank, ..)| *rank) else {
             let seen = if report.is_empty() { "  (no Vulkan devices)".to_string() } else { report.join("\n") };
             return Err(VkError::NoSuitableDevice(format!("devices seen:\n{seen}\nTo fix: {SETUP_HINT}")));
         };
-        Self::create(instance.clone(), physical, swapchain)
+        Self::create(instance.clone(), physical, &caps, swapchain)
     }
 
-    fn create(instance: Arc<Instance>, physical: vk::PhysicalDevice, swapchain: bool) -> Result<Arc<Self>, VkError> {
+    /// The logical device on `physical`, whose capabilities `caps` are, with
+    /// each of ray queries and ray-tracing pipelines that it offers.
+    fn create(
+        instance: Arc<Instance>,
+        physical: vk::PhysicalDevice,
+        caps: &Capabilities,
+        swapchain: bool,
+    ) -> Result<Arc<Self>, VkError> {
         let raw_instance = &instance.raw;
         let properties = unsafe { raw_instance.get_physical_device_properties(physical) };
         let queue_family = unsafe { raw_instance.get_physical_device_queue_family_properties(physical) }
@@ -155,7 +168,6 @@ impl Device {
             ext_names.push(ash::khr::swapchain::NAME.as_ptr());
         }
         // Ray queries and ray-tracing pipelines where offered: the backends.
-        let caps = Capabilities::query(raw_instance, physical);
         if caps.ray_query {
             ext_names.push(ash::khr::ray_query::NAME.as_ptr());
         }
@@ -192,14 +204,9 @@ impl Device {
         let raw = unsafe { raw_instance.create_device(physical, &info, None) }?;
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
         let accel = ash::khr::acceleration_structure::Device::new(raw_instance, &raw);
-        let ray_tracing =
-            caps.ray_tracing_pipeline.then(|| ash::khr::ray_tracing_pipeline::Device::new(raw_instance, &raw));
-        let ray_tracing_limits = caps.pipeline_limits.unwrap_or(PipelineLimits {
-            shader_group_handle_size: 0,
-            shader_group_handle_alignment: 0,
-            shader_group_base_alignment: 0,
-            max_ray_recursion_depth: 0,
-            max_ray_hit_attribute_size: 0,
+        let ray_tracing = caps.pipeline_limits.map(|limits| RayTracing {
+            loader: ash::khr::ray_tracing_pipeline::Device::new(raw_instance, &raw),
+            limits,
         });
 
         let mut as_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
@@ -234,7 +241,6 @@ impl Device {
             max_allocation_bytes: maintenance3.max_memory_allocation_size,
             name,
             ray_tracing,
-            ray_tracing_limits,
             ray_query: caps.ray_query,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
         }))

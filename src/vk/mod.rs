@@ -27,7 +27,7 @@ pub use ash::vk;
 pub use buffer::Buffer;
 pub use capabilities::{preference, survey, Backend, Capabilities, PipelineLimits, Survey};
 pub use commands::{full_barrier, Commands};
-pub use device::{Device, SETUP_HINT};
+pub use device::{Device, RayTracing, SETUP_HINT};
 pub use gpu_allocator::MemoryLocation;
 pub use image::Image;
 pub use instance::{Instance, ValidationCounters};

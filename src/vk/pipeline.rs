@@ -286,8 +286,6 @@ pub struct ComputePipeline {
     pub resources: PipelineResources,
     /// The pipeline.
     pub raw: vk::Pipeline,
-    /// The shader's interface: bindings, spec constants, push constants.
-    pub interface: ShaderInterface,
 }
 
 impl ComputePipeline {
@@ -297,7 +295,7 @@ impl ComputePipeline {
     /// `shader_interface`); an id the shader lacks is an error.
     pub fn new(device: &Arc<Device>, spirv: &[u32], specialization: &[(u32, u32)]) -> Result<Self, VkError> {
         let interface = ShaderInterface::reflect(spirv)?;
-        let resources = PipelineResources::new(device, interface.clone(), vk::ShaderStageFlags::COMPUTE)?;
+        let resources = PipelineResources::new(device, interface, vk::ShaderStageFlags::COMPUTE)?;
         let (mut entries, mut values) = (Vec::new(), Vec::new());
         let spec = resources.specialization(specialization, &mut entries, &mut values)?;
         let raw = &device.raw;
@@ -311,7 +309,7 @@ impl ComputePipeline {
         let created = unsafe { raw.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
         unsafe { raw.destroy_shader_module(module, None) };
         let pipeline = created.map_err(|(_, e)| e)?[0];
-        Ok(Self { resources, raw: pipeline, interface })
+        Ok(Self { resources, raw: pipeline })
     }
 
     /// Points the shader's bindings at resources ([`PipelineResources::bind`]).

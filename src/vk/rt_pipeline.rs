@@ -37,7 +37,8 @@ pub struct RayTracingPipeline {
     pub resources: PipelineResources,
     /// The pipeline.
     pub raw: vk::Pipeline,
-    sbt: Buffer,
+    /// The shader binding table the regions point into (kept alive).
+    _sbt: Buffer,
     /// Ray generation, miss, hit and (empty) callable regions of the table.
     regions: [vk::StridedDeviceAddressRegionKHR; 4],
 }
@@ -53,7 +54,7 @@ impl RayTracingPipeline {
         stages: &RayTracingStages,
         specialization: &[(u32, u32)],
     ) -> Result<Self, VkError> {
-        let Some(rt) = device.ray_tracing.as_ref() else {
+        let Some(super::RayTracing { loader: rt, limits }) = device.ray_tracing.as_ref() else {
             return Err(VkError::NoSuitableDevice(format!(
                 "{} was not created with VK_KHR_ray_tracing_pipeline (the device lacks it)",
                 device.name
@@ -127,7 +128,6 @@ impl RayTracingPipeline {
 
         // The shader binding table: one region per group kind, each at the
         // base alignment, handles at the handle alignment.
-        let limits = device.ray_tracing_limits;
         let handle_size = limits.shader_group_handle_size;
         let handle_stride = align_up(handle_size, limits.shader_group_handle_alignment);
         let region = align_up(handle_stride, limits.shader_group_base_alignment);
@@ -166,7 +166,7 @@ impl RayTracingPipeline {
         // The ray-generation region's stride must equal its size.
         let regions =
             [region_at(0, region), region_at(1, handle_stride), region_at(2, handle_stride), Default::default()];
-        Ok(Self { resources, raw: pipeline, sbt, regions })
+        Ok(Self { resources, raw: pipeline, _sbt: sbt, regions })
     }
 
     /// Points the stages' bindings at resources ([`PipelineResources::bind`]).
@@ -178,12 +178,11 @@ impl RayTracingPipeline {
     /// tracing `size` = (width, height, depth) ray-generation invocations.
     pub fn trace(&self, cmd: vk::CommandBuffer, constants: &[u8], size: [u32; 3]) {
         let device = self.resources.device();
-        let rt = device.ray_tracing.as_ref().expect("checked in new");
+        let rt = &device.ray_tracing.as_ref().expect("checked in new").loader;
         unsafe { device.raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, self.raw) };
         self.resources.record(cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, constants);
         let [raygen, miss, hit, callable] = &self.regions;
         unsafe { rt.cmd_trace_rays(cmd, raygen, miss, hit, callable, size[0], size[1], size[2]) };
-        let _ = &self.sbt;
     }
 }
 
