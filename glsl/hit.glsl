@@ -94,18 +94,4 @@ void completeHit(inout SceneHit h, vec3 o, vec3 d, mat3 worldToObject) {
     h.offset = hitOffset(o + h.t * d, h.cell, g, h.worldToObject);
 }
 
-// Object-frame distance of a ray's origin beyond which the object ray is
-// formed in f64.
-const float REBASE_DISTANCE = 64.0;
-
-// The ray in a candidate's object frame, in f64: the world-to-object
-// transform m applied in f64 to the f32 world origin and direction (the
-// hardware's f32 transform loses ~1e-7 of the origin's distance, 1e-3 at
-// 1e4, and turns the direction by ~1e-7 rad, as much again 1e4 away).
-void objectRay64(mat4x3 m, vec3 worldOrigin, vec3 worldDir, out dvec3 o, out dvec3 d) {
-    dmat3 l = dmat3(dvec3(m[0]), dvec3(m[1]), dvec3(m[2]));
-    o = l * dvec3(worldOrigin) + dvec3(m[3]);
-    d = l * dvec3(worldDir);
-}
-
 #endif

@@ -35,6 +35,14 @@ struct Object {
     float vAxis[3];
     vec2 uvScale;
     vec2 uvOffset;
+    // Rays whose object-frame origin is farther than this from the object's
+    // origin are formed in f64 and searched in a parameter local to each
+    // cell (root_search.glsl, candidateFirstRoot).
+    float rebaseDistance;
+    // The map from the GPU's world frame to the object's, in f64 (columns:
+    // x, y, z, translation): the hardware's f32 instance transform places an
+    // object D away only to ~6e-8 · D.
+    double worldToObject[12];
 };
 
 // A perturbation f · max(Q, 0)³. Q is stored relative to `centre`, the centre

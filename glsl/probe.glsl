@@ -19,7 +19,7 @@ struct Hit {
     uint object;
     float meanCurvature;   // of the outward normal (positive when convex)
     float gaussCurvature;
-    uint pad;
+    float objectPoint[3];  // the hit in the object's frame (the far-view tests)
 };
 
 layout(set = 0, binding = BINDING_PROBE_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
@@ -54,7 +54,7 @@ void probeRay(uint local) {
         outHit.meanCurvature = 0.5 * (s[0][0] + s[1][1]);
         outHit.gaussCurvature = determinant(s);
     }
-    outHit.pad = 0u;
+    outHit.objectPoint = float[3](h.objectPoint.x, h.objectPoint.y, h.objectPoint.z);
     hits[i] = outHit;
 }
 

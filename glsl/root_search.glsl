@@ -80,7 +80,8 @@ bool signUncertain(float c[7], float x) {
 // expanded around tm: keeps tr where f64 confirms a sign change around it
 // and f32 is well conditioned there, else finds the root again in f64, or
 // drops it when f64 sees no sign change (see above). Returns a ray
-// parameter, or -1 for none.
+// parameter, or NO_ROOT for none (parameters may be negative: far rays
+// are searched from a point inside the cell, candidateFirstRoot).
 double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double tb, double tm, float c[7], float tr) {
     bool startUncertain = signUncertain(c, float(ta - tm));
     double t = tm + double(tr);
@@ -102,7 +103,7 @@ double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double 
         }
         if (!startUncertain && 16.0 * 5.96e-8 * size <= 1e-5 * float(tb - ta) * abs(slope)) return t;
     } else if (!startUncertain && !signUncertain(c, float(tb - tm))) {
-        return -1.0;
+        return double(NO_ROOT);
     }
     bool flatRoot = found && (signUncertain(c, tr + step) || signUncertain(c, tr - step));
     // F' in f64 at the piece's start, its middle, either side of the f32
@@ -127,7 +128,7 @@ double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double 
     [[dont_unroll]] for (int i = 0; i < 4 && lo < 0; ++i) {
         if ((v[i] < 0.0) != (v[i + 1] < 0.0)) lo = i;
     }
-    if (lo < 0) return -1.0;
+    if (lo < 0) return double(NO_ROOT);
     if (found && !flatRoot && at[lo] <= t && t <= at[lo + 1] && at[lo + 1] - at[lo] <= 2.0 * w) return t;
     if (v[lo] == 0.0) return at[lo];
     return bracketedRoot64(object, cell, O, D, at[lo], at[lo + 1], v[lo], v[lo + 1]);
@@ -257,7 +258,7 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
                 dvec3 O = rebased ? o64 : dvec3(o), D = rebased ? d64 : dvec3(d);
                 double t64 = refineRoot64(object, cell, O, D, double(tc) + double(sa), double(tc) + double(sb),
                                           double(tc) + double(sm), c, r);
-                if (t64 >= 0.0) {
+                if (t64 != double(NO_ROOT)) {
                     hitPoint = vec3(O + t64 * D);
                     return float(t64);
                 }
@@ -270,6 +271,60 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
         segLo = segHi;
     }
     return NO_ROOT;
+}
+
+// ---------------------------------------------------------------------------
+// Rays from far away. The hardware hands each candidate its object-frame ray
+// in f32, and a ray parameter t is f32 too: one step of t is ~6e-8 · t, so
+// seen from D object sizes, slab tests, breakpoints and roots are placed to
+// ~6e-8 · D sizes (0.6 % of the object at 1e5, 6 % at 1e6), and a segment
+// may overshoot its cell by that much, into perturbations its list does not
+// hold. So a candidate whose object-frame origin is farther than the
+// object's rebaseDistance (at most 64 object units and 64 of its sizes) is
+// searched in f64 terms: its object ray is formed in f64 from the world ray
+// through the object's f64 transform, and re-based to the point of the ray
+// nearest the cell's centre, tref; the search then runs in s = t - tref,
+// whose f32 steps are those of the cell's size, and t = tref + s is
+// returned in f64 (docs/stability.md, "Far views").
+// ---------------------------------------------------------------------------
+
+// The ray in object `object`'s frame, in f64: its f64 world-to-object map
+// applied to the f32 world origin and direction.
+void objectRay64(uint object, vec3 worldOrigin, vec3 worldDir, out dvec3 o, out dvec3 d) {
+    double m[12] = objects[object].worldToObject;
+    dmat3 l = dmat3(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8]);
+    o = l * dvec3(worldOrigin) + dvec3(m[9], m[10], m[11]);
+    d = l * dvec3(worldDir);
+}
+
+// The first root of F' in one candidate box (cell `cellIndex` of `object`):
+// (o, d) is the hardware's f32 object ray, (worldOrigin, worldDir) the world
+// ray, and roots are sought for t in [tmin, tmax] (tmax64: tmax in f64, the
+// closest root so far). Returns s, or NO_ROOT for none: the root is at
+// t = tref + s, where `far` tells whether the ray was re-based (as above);
+// a near ray has tref = 0 and is searched in f32 alone, as before far rays
+// were re-based. Both backends call it (traverse.glsl, intersect.rint),
+// once per candidate (one call site of cellFirstRoot: the compiler inlines
+// it).
+float candidateFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, vec3 worldOrigin, vec3 worldDir, float tmin,
+                         float tmax, double tmax64, out bool far, out double tref, out vec3 hitPoint) {
+    float rebase = objects[object].rebaseDistance;
+    far = dot(o, o) > rebase * rebase;
+    dvec3 o64 = dvec3(0.0), d64 = dvec3(0.0);
+    tref = 0.0;
+    float lo = tmin, hi = tmax;
+    if (far) {
+        objectRay64(object, worldOrigin, worldDir, o64, d64);
+        Cell cell = cells[cellIndex];
+        dvec3 centre = 0.5 * (dvec3(cell.lo[0], cell.lo[1], cell.lo[2]) + dvec3(cell.hi[0], cell.hi[1], cell.hi[2]));
+        tref = dot(centre - o64, d64) / dot(d64, d64);
+        o64 += tref * d64;
+        o = vec3(o64);
+        d = vec3(d64);
+        lo = float(double(tmin) - tref);
+        hi = float(tmax64 - tref);
+    }
+    return cellFirstRoot(object, cellIndex, o, d, far, o64, d64, lo, hi, hitPoint);
 }
 
 #endif

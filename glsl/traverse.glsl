@@ -13,39 +13,43 @@
 #define candidateCell(rq, object, committed) \
     (objects[object].firstCell + uint(rayQueryGetIntersectionPrimitiveIndexEXT(rq, committed)))
 
-void candidateObjectRay64(rayQueryEXT rq, out dvec3 o, out dvec3 d) {
-    objectRay64(rayQueryGetIntersectionWorldToObjectEXT(rq, false), rayQueryGetWorldRayOriginEXT(rq),
-                rayQueryGetWorldRayDirectionEXT(rq), o, d);
-}
-
-// Runs the candidate loop: for each AABB, the first root in the cell.
+// Runs the candidate loop: for each AABB, the first root in the cell
+// (candidateFirstRoot). The closest root of far rays is kept in f64 too,
+// so that roots closer together than one f32 step of t keep their order.
 // Returns the object-space point of the closest root found.
 vec3 proceedFunctional(rayQueryEXT rq, float tmin, float tmax) {
     float best = tmax;
+    double best64 = double(tmax);
     vec3 bestPoint = vec3(0.0);
-    // Rays from far away (object-frame origin beyond REBASE_DISTANCE) form
-    // their object ray in f64; nearer rays use the hardware's f32 object
-    // ray, whose error (~1e-7 of the distance) is then below 1e-5. Cost
-    // measured on lavapipe (`make bench`, one run each, alternated): 0 – 10 %
-    // more time for near rays (the f64 path present in the shader).
     while (rayQueryProceedEXT(rq)) {
         if (rayQueryGetIntersectionTypeEXT(rq, false) != gl_RayQueryCandidateIntersectionAABBEXT) continue;
         uint object = candidateObject(rq, false);
-        vec3 o = rayQueryGetIntersectionObjectRayOriginEXT(rq, false);
-        vec3 d = rayQueryGetIntersectionObjectRayDirectionEXT(rq, false);
-        bool rebased = dot(o, o) > REBASE_DISTANCE * REBASE_DISTANCE;
-        dvec3 o64 = dvec3(0.0), d64 = dvec3(0.0);
-        if (rebased) {
-            candidateObjectRay64(rq, o64, d64);
-            o = vec3(o64);
-            d = vec3(d64);
-        }
         vec3 point;
-        float t = cellFirstRoot(object, candidateCell(rq, object, false), o, d, rebased, o64, d64, tmin, best, point);
-        if (t != NO_ROOT && t <= best) {
-            best = t;
-            bestPoint = point;
-            rayQueryGenerateIntersectionEXT(rq, t);
+        bool far;
+        double tref;
+        float s = candidateFirstRoot(object, candidateCell(rq, object, false),
+                                     rayQueryGetIntersectionObjectRayOriginEXT(rq, false),
+                                     rayQueryGetIntersectionObjectRayDirectionEXT(rq, false),
+                                     rayQueryGetWorldRayOriginEXT(rq), rayQueryGetWorldRayDirectionEXT(rq), tmin, best,
+                                     best64, far, tref, point);
+        if (s == NO_ROOT) continue;
+        if (!far) {
+            if (s <= best) {
+                best = s;
+                best64 = double(s);
+                bestPoint = point;
+                rayQueryGenerateIntersectionEXT(rq, s);
+            }
+        } else {
+            // The bounds, rounded to f32 in s, may admit a root a hair
+            // outside them.
+            double t = max(tref + double(s), double(tmin));
+            if (t <= best64) {
+                best64 = t;
+                best = float(t);
+                bestPoint = point;
+                rayQueryGenerateIntersectionEXT(rq, best);
+            }
         }
     }
     return bestPoint;

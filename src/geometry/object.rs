@@ -229,9 +229,14 @@ impl FunctionalObject {
     }
 
     fn split(&self, bx: Aabb, candidates: &[u32], depth: u32, pad: f64, params: &CellParams, out: &mut Vec<Cell>) {
-        let Some(active) = self.active_in(&bx.padded(pad), candidates) else { return };
+        // The list is taken over the box grown by twice the padding, so that
+        // it holds a padding's width beyond the cell (the padded box): a
+        // GPU segment that overshoots its cell by f32 rounding (~1e-7 of
+        // the object's size in the cell-local search) never meets a
+        // perturbation the list lacks.
+        let Some(active) = self.active_in(&bx.padded(2.0 * pad), candidates) else { return };
         if active.len() <= params.max_perturbations || depth >= params.max_depth {
-            // The list holds for the whole padded box, so also for any box in it.
+            // The list holds for the whole grown box, so also for any box in it.
             if let Some(tight) = self.tighten(bx, &active, params.tighten_depth) {
                 out.push(Cell { bounds: tight.padded(pad), perturbations: active });
             }
@@ -399,5 +404,35 @@ mod tests {
                 assert!(cell.perturbations.contains(&k));
             }
         }
+    }
+
+    /// A cell's list holds a padding's width beyond its box (the margin the
+    /// GPU's f32 segments may overshoot it by): over every cell's box grown
+    /// by the padding, each perturbation off the list is proved non-positive
+    /// by interval bounds. The property holds for any padding; a large one
+    /// (2 % of the diagonal) makes the margin wide enough that lists taken
+    /// over the padded box only (as before issue 20) fail it.
+    #[test]
+    fn cell_lists_hold_a_padding_beyond_their_boxes() {
+        let mut o = sphere();
+        o.perturbations = crate::geometry::scatter::spread_bumps(60, DVec3::ONE, 0.3, 0.5, true);
+        let params = CellParams { padding: 0.02, ..CellParams::default() };
+        let pad = params.padding * o.bounds().unwrap().size().length();
+        let cells = o.cells(&params).unwrap();
+        let mut checked = 0;
+        for cell in &cells {
+            let grown = cell.bounds.padded(pad);
+            for (k, pert) in o.perturbations.iter().enumerate() {
+                if !cell.perturbations.contains(&(k as u32)) {
+                    checked += 1;
+                    let (_, hi) = pert.quadric.range_over(&grown);
+                    assert!(
+                        hi <= 0.0,
+                        "perturbation {k} may be active within a padding of a cell that does not list it"
+                    );
+                }
+            }
+        }
+        assert!(checked > 1000, "only {checked} unlisted perturbations checked");
     }
 }

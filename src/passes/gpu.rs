@@ -57,11 +57,25 @@ pub struct GpuObject {
     pub uv_scale: [f32; 2],
     /// UV offset.
     pub uv_offset: [f32; 2],
+    /// Object-frame distance of a ray's origin beyond which the ray is formed
+    /// in f64 and searched in a parameter local to each cell
+    /// ([`GpuObject::rebase_distance`]).
+    pub rebase_distance: f32,
+    /// The map from the GPU's world frame to the object's in f64, column
+    /// major (x, y, z, translation).
+    pub world_to_object: [f64; 12],
 }
 
+/// Object-frame distance (in object units, and in sizes of the object's box)
+/// beyond which rays are re-based (`glsl/root_search.glsl`): there an f32
+/// ray parameter resolves 6e-8 · 64 = 4e-6 of the distance.
+pub const REBASE_DISTANCE: f64 = 64.0;
+
 impl GpuObject {
-    /// The object's base quadric, material and texture coordinates.
-    pub fn new(object: &SceneObject, first_cell: u32) -> Self {
+    /// The object's base quadric, material and texture coordinates, and its
+    /// placement: `to_world` maps its frame to the GPU's world frame (the
+    /// scene's, relative to the frame's origin).
+    pub fn new(object: &SceneObject, first_cell: u32, to_world: &DAffine3) -> Self {
         let (uv_mapping, u_axis, v_axis) = match object.uv.mapping {
             UvMapping::Planar { u_axis, v_axis } => (UV_PLANAR, u_axis, v_axis),
             UvMapping::Spherical => (UV_SPHERICAL, DVec3::X, DVec3::Z),
@@ -76,7 +90,18 @@ impl GpuObject {
             v_axis: v_axis.as_vec3().to_array(),
             uv_scale: object.uv.scale.as_vec2().to_array(),
             uv_offset: object.uv.offset.as_vec2().to_array(),
+            rebase_distance: Self::rebase_distance(object) as f32,
+            world_to_object: to_world.inverse().to_cols_array(),
         }
+    }
+
+    /// [`REBASE_DISTANCE`] object units, or that many half-diagonals of the
+    /// object's box where the object is smaller than a unit: what f32 can
+    /// resolve is relative to the distance, so a small object needs the f64
+    /// path nearer.
+    pub fn rebase_distance(object: &SceneObject) -> f64 {
+        let size = object.shape.bounds().map_or(1.0, |b| 0.5 * b.size().length());
+        REBASE_DISTANCE * size.min(1.0)
     }
 }
 
@@ -414,8 +439,8 @@ pub struct GpuHit {
     pub mean_curvature: f32,
     /// Gaussian curvature, 1/length².
     pub gauss_curvature: f32,
-    /// Padding.
-    pub pad: u32,
+    /// The hit in the object's frame.
+    pub object_point: [f32; 3],
 }
 
 /// Push constants of render.comp.
@@ -570,7 +595,9 @@ pub struct CausticPush {
 pub fn host_layouts() -> Vec<HostLayout> {
     vec![
         host_layout!(GpuQuadric as "Quadric" { a, b, c }),
-        host_layout!(GpuObject as "Object" { base, material, first_cell, uv_mapping, u_axis, v_axis, uv_scale, uv_offset }),
+        host_layout!(GpuObject as "Object" {
+            base, material, first_cell, uv_mapping, u_axis, v_axis, uv_scale, uv_offset, rebase_distance, world_to_object
+        }),
         host_layout!(GpuPerturbation as "Perturbation" { q, f, centre, radius }),
         host_layout!(GpuCell as "Cell" { lo, hi, first, count }),
         host_layout!(GpuMaterial as "Material" {
@@ -589,7 +616,7 @@ pub fn host_layouts() -> Vec<HostLayout> {
         }),
         host_layout!(GpuPathRecord as "PathRecord" { count, vertices }),
         host_layout!(GpuRay as "Ray" { origin, tmin, dir, tmax }),
-        host_layout!(GpuHit as "Hit" { t, normal, object, mean_curvature, gauss_curvature, pad }),
+        host_layout!(GpuHit as "Hit" { t, normal, object, mean_curvature, gauss_curvature, object_point }),
         host_layout!(GpuTexQuery as "TexQuery" { texture, alpha, uv, axis1, axis2 }),
         host_layout!(GpuTexResult as "TexResult" { value, alpha, pad }),
         host_layout!(GpuCausticRay as "CausticRay" { position, object, flux, path, beam_start, in_fog }),

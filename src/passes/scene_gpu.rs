@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use glam::{DAffine3, DVec3};
+use glam::{DAffine3, DMat3, DVec3};
 
 use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
 use super::IntersectMode;
@@ -197,6 +197,41 @@ fn f32_box(b: &Aabb) -> ([f32; 3], [f32; 3]) {
     (lo, hi)
 }
 
+/// How far from the GPU frame's `origin` rays can start: the farthest
+/// point of any object's box (secondary rays start on surfaces; camera rays
+/// at the origin).
+fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
+    scene
+        .objects
+        .iter()
+        .filter_map(|o| {
+            let b = o.shape.bounds().ok()?;
+            let centre = o.transform.transform_point3(0.5 * (b.min + b.max));
+            let radius = 0.5 * b.size().length() * frobenius(&o.transform.matrix3);
+            Some((centre - origin).length() + radius)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// A bound, in object units, on the error of the object-frame ray the
+/// hardware forms from its f32 instance transform (`to_world` rounded, then
+/// inverted) for rays starting within `reach` of the frame's origin: 8 f32
+/// roundings of the distances involved (the translation's, the inverse's and
+/// the transform of the origin each round a few times), through the
+/// inverse's largest stretch (its Frobenius norm bounds it). Seen from 1e6
+/// object sizes this is about one object size; for a scene within ~30 units
+/// of the camera it is below the cells' own padding, and the boxes are
+/// unchanged.
+fn placement_error(to_world: &DAffine3, reach: f64) -> f64 {
+    let stretch = frobenius(&to_world.matrix3.inverse());
+    8.0 * f64::from(f32::EPSILON) * 0.5 * stretch * (to_world.translation.length() + reach)
+}
+
+/// The Frobenius norm of a matrix: a bound on how far it stretches a vector.
+fn frobenius(m: &DMat3) -> f64 {
+    m.to_cols_array().iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
 /// Row-major 3x4 matrix of an affine transform.
 fn row_major_3x4(m: &DAffine3) -> [f32; 12] {
     let c = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation];
@@ -250,6 +285,7 @@ impl GpuScene {
         let mut lists: Vec<u32> = Vec::new();
         let mut blases = Vec::new();
         let mut placements = Vec::new();
+        let reach = scene_reach(scene, origin);
 
         for (index, object) in scene.objects.iter().enumerate() {
             let object_cells = object
@@ -259,19 +295,25 @@ impl GpuScene {
             let first_perturbation = perturbations.len() as u32;
             perturbations.extend(object.shape.perturbations.iter().map(GpuPerturbation::from));
             let first_cell = cells.len() as u32;
-            objects.push(GpuObject::new(object, first_cell));
+            let relative = DAffine3::from_translation(-origin) * object.transform;
+            objects.push(GpuObject::new(object, first_cell, &relative));
             if object_cells.is_empty() {
                 continue;
             }
+            // The boxes the hardware culls with cover its f32 placement's
+            // error where that exceeds the cells' own padding (far objects);
+            // the root search itself keeps to the cells' bounds.
+            let cell_pad = params.padding * object.shape.bounds().map_or(0.0, |b| b.size().length());
+            let grow = (placement_error(&relative, reach) - cell_pad).max(0.0);
             let mut aabbs = Vec::with_capacity(object_cells.len());
             for c in &object_cells {
                 let (lo, hi) = f32_box(&c.bounds);
-                aabbs.push([lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]);
+                let (blo, bhi) = if grow > 0.0 { f32_box(&c.bounds.padded(grow)) } else { (lo, hi) };
+                aabbs.push([blo[0], blo[1], blo[2], bhi[0], bhi[1], bhi[2]]);
                 cells.push(GpuCell { lo, hi, first: lists.len() as u32, count: c.perturbations.len() as u32 });
                 lists.extend(c.perturbations.iter().map(|&i| first_perturbation + i));
             }
             blases.push(AccelerationStructure::bottom_level_aabbs(device, cmds, &aabbs)?);
-            let relative = DAffine3::from_translation(-origin) * object.transform;
             placements.push((blases.len() - 1, relative, index as u32));
         }
 

@@ -44,6 +44,16 @@ pub fn gpu() -> (Context, Arc<ValidationCounters>, Commands) {
     (ctx, counters, cmds)
 }
 
+/// Ends a GPU test that checks a table of bounds: drops the command pool and
+/// the device (so that leaks reported at destruction count), fails on any
+/// validation error, then on any bound a row of the table broke.
+pub fn finish_bounded(ctx: Context, cmds: Commands, counters: &Arc<ValidationCounters>, violations: &[String]) {
+    drop(cmds);
+    drop(ctx);
+    assert_no_validation_errors(counters);
+    assert!(violations.is_empty(), "beyond the bounds: {violations:?}");
+}
+
 /// Fails when the validation layer reported any error; call after dropping
 /// the context so that leaks reported at device destruction count too.
 pub fn assert_no_validation_errors(counters: &Arc<ValidationCounters>) {

@@ -7,6 +7,7 @@
 mod common;
 
 mod covariance;
+mod far_views;
 mod geometry_gpu;
 mod offsets;
 mod root_multiplicity;

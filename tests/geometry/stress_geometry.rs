@@ -209,10 +209,7 @@ fn scales_and_offsets_against_the_f64_reference() {
     println!(
         "bounds where ε <= {TRUSTED_EPSILON:e}: no unexcused disagreement, depth error <= {MAX_DEPTH_ERROR:e} + ε, normal {MAX_NORMAL_DEGREES}°"
     );
-    drop(cmds);
-    drop(ctx);
-    common::assert_no_validation_errors(&counters);
-    assert!(violations.is_empty(), "beyond the bounds: {violations:?}");
+    common::finish_bounded(ctx, cmds, &counters, &violations);
 }
 
 /// Whether `p` lies within 1e-5 of the box's size of one of its faces.
@@ -358,8 +355,5 @@ fn shapes_at_the_extremes_against_the_f64_reference() {
             violations.push(e.name);
         }
     }
-    drop(cmds);
-    drop(ctx);
-    common::assert_no_validation_errors(&counters);
-    assert!(violations.is_empty(), "beyond the bounds: {violations:?}");
+    common::finish_bounded(ctx, cmds, &counters, &violations);
 }
