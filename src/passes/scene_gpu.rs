@@ -10,7 +10,7 @@ use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
 use super::IntersectMode;
 use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
-use crate::scene::{Scene, TextureImage};
+use crate::scene::{Light, Scene, TextureImage};
 use crate::shader_interface::{
     BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_MATERIALS, BINDING_OBJECTS,
     BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE,
@@ -197,11 +197,13 @@ fn f32_box(b: &Aabb) -> ([f32; 3], [f32; 3]) {
     (lo, hi)
 }
 
-/// How far from the GPU frame's `origin` rays can start: the farthest
-/// point of any object's box (secondary rays start on surfaces; camera rays
-/// at the origin).
+/// How far from the GPU frame's `origin` rays can start: the farthest point
+/// of any object's box (secondary rays start on surfaces; camera rays at the
+/// origin) or of any light (caustic photons start on lights; a directional
+/// light's start on a plane 2 radii + 1 beyond the specular objects'
+/// bounding sphere, `caustics::parallel_grid`: within 3 reaches + 1).
 fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
-    scene
+    let objects = scene
         .objects
         .iter()
         .filter_map(|o| {
@@ -210,7 +212,14 @@ fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
             let radius = 0.5 * b.size().length() * frobenius(&o.transform.matrix3);
             Some((centre - origin).length() + radius)
         })
-        .fold(0.0, f64::max)
+        .fold(0.0, f64::max);
+    let lights = scene.lights.iter().map(|l| match *l {
+        Light::Point { position, .. } => (position - origin).length(),
+        Light::Sphere { centre, radius, .. } => (centre - origin).length() + radius,
+        Light::Rect { corner, edge_u, edge_v, .. } => (corner - origin).length() + edge_u.length() + edge_v.length(),
+        Light::Directional { .. } => 3.0 * objects + 1.0,
+    });
+    lights.fold(objects, f64::max)
 }
 
 /// A bound, in object units, on the error of the object-frame ray the
