@@ -164,7 +164,7 @@ pub(crate) enum BackendChoice {
     /// Compute shaders with ray queries (VK_KHR_ray_query).
     RayQuery,
     /// A ray-tracing pipeline with the intersection shader
-    /// (VK_KHR_ray_tracing_pipeline) for the render pass.
+    /// (VK_KHR_ray_tracing_pipeline) for every tracing pass.
     Pipeline,
 }
 

@@ -45,10 +45,10 @@ pub(crate) struct RenderArgs {
     /// those passes are compared with).
     #[arg(long)]
     pub(crate) brute_force: bool,
-    /// How the render pass traces rays: `auto` (ray queries where the device
-    /// has them), `ray-query`, or `pipeline` (a ray-tracing pipeline whose
-    /// intersection shader solves the first roots; the caustic and volume
-    /// passes still use ray queries). The images agree to float rounding.
+    /// How every tracing pass traces rays: `auto` (ray queries where the
+    /// device has them), `ray-query`, or `pipeline` (a ray-tracing pipeline
+    /// whose intersection shader solves the first roots; the render, caustic
+    /// and volume passes alike). The images agree to float rounding.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto, env = "QUADRAY_BACKEND")]
     pub(crate) backend: BackendChoice,
     /// Write checkpoints of the work so far to this file (atomically), every

@@ -68,6 +68,13 @@ pub struct CellParams {
     pub padding: f64,
 }
 
+impl CellParams {
+    /// The padding in object units for an object whose box is `bounds`.
+    pub fn pad(&self, bounds: &Aabb) -> f64 {
+        self.padding * bounds.size().length()
+    }
+}
+
 impl Default for CellParams {
     fn default() -> Self {
         Self { max_perturbations: 8, max_depth: 18, tighten_depth: 6, padding: 1e-5 }
@@ -197,7 +204,7 @@ impl FunctionalObject {
     /// `max_perturbations` perturbations.
     pub fn cells(&self, params: &CellParams) -> Result<Vec<Cell>, GeometryError> {
         let bounds = self.bounds()?;
-        let pad = params.padding * bounds.size().length();
+        let pad = params.pad(&bounds);
         let all: Vec<u32> = (0..self.perturbations.len() as u32).collect();
         let mut out = Vec::new();
         self.split(bounds, &all, 0, pad, params, &mut out);
@@ -417,7 +424,7 @@ mod tests {
         let mut o = sphere();
         o.perturbations = crate::geometry::scatter::spread_bumps(60, DVec3::ONE, 0.3, 0.5, true);
         let params = CellParams { padding: 0.02, ..CellParams::default() };
-        let pad = params.padding * o.bounds().unwrap().size().length();
+        let pad = params.pad(&o.bounds().unwrap());
         let cells = o.cells(&params).unwrap();
         let mut checked = 0;
         for cell in &cells {

@@ -41,7 +41,7 @@ pub fn intersect_within(
     // re-basing itself rounds once, ~1e-16 of the distance (1e-9 object
     // sizes at 1e7), and F' along the ray no longer cancels terms of the
     // distance's square.
-    let tref = (0.5 * (bounds.min + bounds.max) - o).dot(d) / d.length_squared();
+    let tref = (bounds.centre() - o).dot(d) / d.length_squared();
     let tref = if tref.is_finite() { tref } else { 0.0 };
     let hit = intersect_from(obj, bounds, o + tref * d, d, t_min - tref, t_max - tref)?;
     Some(Hit { t: tref + hit.t, ..hit })

@@ -208,7 +208,7 @@ fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
         .iter()
         .filter_map(|o| {
             let b = o.shape.bounds().ok()?;
-            let centre = o.transform.transform_point3(0.5 * (b.min + b.max));
+            let centre = o.transform.transform_point3(b.centre());
             let radius = 0.5 * b.size().length() * frobenius(&o.transform.matrix3);
             Some((centre - origin).length() + radius)
         })
@@ -312,7 +312,7 @@ impl GpuScene {
             // The boxes the hardware culls with cover its f32 placement's
             // error where that exceeds the cells' own padding (far objects);
             // the root search itself keeps to the cells' bounds.
-            let cell_pad = params.padding * object.shape.bounds().map_or(0.0, |b| b.size().length());
+            let cell_pad = object.shape.bounds().map_or(0.0, |b| params.pad(&b));
             let grow = (placement_error(&relative, reach) - cell_pad).max(0.0);
             let mut aabbs = Vec::with_capacity(object_cells.len());
             for c in &object_cells {

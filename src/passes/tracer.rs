@@ -31,7 +31,7 @@ impl Tracer {
         raygen: fn() -> Vec<u32>,
         specialization: &[(u32, u32)],
     ) -> Result<Self, VkError> {
-        let backend = if device.ray_query { backend } else { Backend::Pipeline };
+        let backend = if device.offers(Backend::RayQuery) { backend } else { Backend::Pipeline };
         Ok(match backend {
             Backend::RayQuery => Tracer::RayQuery(ComputePipeline::new(device, &compute(), specialization)?),
             Backend::Pipeline => {

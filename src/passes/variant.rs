@@ -104,9 +104,9 @@ pub struct RenderVariant {
     pub record_path: bool,
     /// The filtered modes' texture lookup.
     pub lookup: LookupMode,
-    /// How the render pass traces rays: ray queries, or a ray-tracing
-    /// pipeline with the intersection shader. The caustic and volume passes
-    /// use ray queries.
+    /// How every tracing pass (render, caustic G-buffer and rays, volume)
+    /// traces rays: ray queries, or a ray-tracing pipeline with the
+    /// intersection shader.
     pub backend: Backend,
 }
 
