@@ -21,7 +21,7 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
 uint gcdOf(uint a, uint b) {
-    while (b != 0u) {
+    while (b != 0u) { LOOP_EDGE();
         uint r = a % b;
         a = b;
         b = r;
@@ -34,7 +34,7 @@ uint gcdOf(uint a, uint b) {
 // permutation of 0 .. N-1.
 uint balancedStride(uint n) {
     uint s = max(uint(float(n) * 0.618034), 1u);
-    while (gcdOf(s, n) != 1u) ++s;
+    while (gcdOf(s, n) != 1u) { LOOP_EDGE(); ++s; }
     return s;
 }
 

@@ -63,7 +63,7 @@ void traceCausticRay(uint i) {
     MediaStack media = emptyStack();
     uint path = 2166136261u;
     uint speculars = 0u;
-    for (uint step = 0u; step < 4u * e.maxSpecular + 8u; ++step) {
+    for (uint step = 0u; step < 4u * e.maxSpecular + 8u; ++step) { LOOP_EDGE();
         SceneHit h = traceScene(o, d, 0.0, 1e30);
         if (h.object == NO_HIT) break;
         if (MEDIA_ENABLED != 0u) {

@@ -2,6 +2,12 @@
 #ifndef COMMON_GLSL
 #define COMMON_GLSL
 
+// One pass through a loop's body for the loop-budget counter: counted in
+// the tracing shaders, which include loop_budget.glsl first; empty elsewhere.
+#ifndef LOOP_EDGE
+#define LOOP_EDGE()
+#endif
+
 const float PI = 3.14159265358979;
 
 // "No root / no hit" distance.

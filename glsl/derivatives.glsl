@@ -8,7 +8,7 @@
 vec3 cellGradient(uint object, uint cellIndex, vec3 p) {
     Cell cell = cells[cellIndex];
     vec3 g = quadricGradient(objects[object].base, p);
-    for (uint i = 0; i < cell.count; ++i) {
+    for (uint i = 0; i < cell.count; ++i) { LOOP_EDGE();
         uint k = cellLists[cell.first + i];
         vec3 h = p - v3(perturbations[k].centre);
         float radius = perturbations[k].radius;
@@ -28,7 +28,7 @@ mat3 quadricHessian(Quadric q) {
 mat3 cellHessian(uint object, uint cellIndex, vec3 p) {
     Cell cell = cells[cellIndex];
     mat3 hess = quadricHessian(objects[object].base);
-    for (uint i = 0; i < cell.count; ++i) {
+    for (uint i = 0; i < cell.count; ++i) { LOOP_EDGE();
         uint k = cellLists[cell.first + i];
         vec3 h = p - v3(perturbations[k].centre);
         float radius = perturbations[k].radius;

@@ -36,7 +36,7 @@ float envTexelProbability(ivec2 t, uint w, uint h) {
 // The largest k in [0, n - 1] with the table's entry base + k <= u.
 uint searchCdf(uint base, uint n, float u) {
     uint lo = 0u, hi = n - 1u;
-    while (lo < hi) {
+    while (lo < hi) { LOOP_EDGE();
         uint mid = (lo + hi + 1u) / 2u;
         if (envCdfAt(base + mid) <= u) lo = mid; else hi = mid - 1u;
     }

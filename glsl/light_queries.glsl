@@ -12,7 +12,7 @@
 uint firstLightHit(vec3 o, vec3 d, float tmax, uint except, out float tHit) {
     uint which = frame.lightCount;
     tHit = tmax;
-    for (uint i = 0; i < frame.lightCount; ++i) {
+    for (uint i = 0; i < frame.lightCount; ++i) { LOOP_EDGE();
         if (i == except) continue;
         float t = lightHit(lights[i], o, d);
         if (t < tHit) {

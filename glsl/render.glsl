@@ -507,7 +507,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
     ShadowRay sr;
     // One ray query per iteration, at this one call site: a waiting shadow
     // ray first, else the path's next segment.
-    for (;;) {
+    for (;;) { LOOP_EDGE();
         bool shadow = shadowRayCount > 0u;
         if (!shadow && !(alive && bounce < lastBounce && step < 4u * frame.maxDepth + 8u)) break;
         if (shadow) sr = shadowRayCount == 2u ? shadowRay1 : shadowRay0;

@@ -25,7 +25,7 @@ double quadricAt64(Quadric q, dvec3 p) {
 // F' at the object-frame point p, with every perturbation the cell lists.
 double cellValue64(uint object, Cell cell, dvec3 p) {
     double v = quadricAt64(objects[object].base, p);
-    [[dont_unroll]] for (uint i = 0; i < cell.count; ++i) {
+    [[dont_unroll]] for (uint i = 0; i < cell.count; ++i) { LOOP_EDGE();
         uint k = cellLists[cell.first + i];
         double q = quadricAt64(perturbations[k].q, p - dvec3(v3(perturbations[k].centre)));
         if (q > 0.0) v += double(perturbations[k].f) * q * q * q;
@@ -38,7 +38,7 @@ double cellValue64(uint object, Cell cell, dvec3 p) {
 double bracketedRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double a, double b, double fa, double fb) {
     int side = 0;
     double c = a;
-    [[dont_unroll]] for (int it = 0; it < 60; ++it) {
+    [[dont_unroll]] for (int it = 0; it < 60; ++it) { LOOP_EDGE();
         c = (a * fb - b * fa) / (fb - fa);
         if (!(c > a && c < b)) c = 0.5 * (a + b);
         double fc = cellValue64(object, cell, O + c * D);
@@ -64,7 +64,7 @@ bool nearlyCancels(float c[7], float x, float tolerance) {
     float slope;
     float v = evalPoly(c, x, slope);
     float size = 0.0, xp = 1.0;
-    for (int j = 0; j < 7; ++j) {
+    for (int j = 0; j < 7; ++j) { LOOP_EDGE();
         size += abs(c[j]) * xp;
         xp *= abs(x);
     }
@@ -97,7 +97,7 @@ double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double 
         float slope;
         evalPoly(c, tr, slope);
         float size = 0.0, xp = 1.0;
-        for (int j = 0; j < 7; ++j) {
+        for (int j = 0; j < 7; ++j) { LOOP_EDGE();
             size += abs(c[j]) * xp;
             xp *= abs(tr);
         }
@@ -114,7 +114,7 @@ double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double 
     double rootLo = found ? max(ta, t - w) : tm, rootHi = found ? min(tb, t + w) : tm;
     double at[5] = double[5](ta, min(rootLo, tm), clamp(tm, rootLo, rootHi), max(rootHi, tm), tb);
     double v[5];
-    [[dont_unroll]] for (int i = 0; i < 5; ++i) v[i] = cellValue64(object, cell, O + at[i] * D);
+    [[dont_unroll]] for (int i = 0; i < 5; ++i) { LOOP_EDGE(); v[i] = cellValue64(object, cell, O + at[i] * D); }
     // The root is in the first interval whose ends differ in sign in f64:
     // the f32 root itself when that interval is the one around it and f32
     // is well conditioned there, else found again in f64. Looking at the
@@ -125,7 +125,7 @@ double refineRoot64(uint object, Cell cell, dvec3 O, dvec3 D, double ta, double 
     // spurious root at the piece's start instead). No sign change in f64:
     // no root (f32 made it up).
     int lo = -1;
-    [[dont_unroll]] for (int i = 0; i < 4 && lo < 0; ++i) {
+    [[dont_unroll]] for (int i = 0; i < 4 && lo < 0; ++i) { LOOP_EDGE();
         if ((v[i] < 0.0) != (v[i + 1] < 0.0)) lo = i;
     }
     if (lo < 0) return double(NO_ROOT);
@@ -173,16 +173,16 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
     // segment has more (many overlapping perturbations), the cell's whole list
     // is used, read from memory (slower, still exact).
     float segLo = s0;
-    for (int split = 0; split < 64 && segLo < s1; ++split) {
+    for (int split = 0; split < 64 && segLo < s1; ++split) { LOOP_EDGE();
         float segHi = s1;
         vec3 relQ[MAX_RELEVANT];
         float relF[MAX_RELEVANT];
         uint nrel = 0u;
         bool overflow = false;
-        for (int attempt = 0; attempt < 8; ++attempt) {
+        for (int attempt = 0; attempt < 8; ++attempt) { LOOP_EDGE();
             nrel = 0u;
             overflow = false;
-            for (uint i = 0; i < cell.count; ++i) {
+            for (uint i = 0; i < cell.count; ++i) { LOOP_EDGE();
                 uint k = cellLists[cell.first + i];
                 vec3 q;
                 if (perturbationOnSegment(k, p, d, segLo, segHi, q)) {
@@ -216,9 +216,9 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
         // F' is a polynomial of degree <= 6, expanded around the piece's own
         // middle so that its coefficients stay well conditioned in f32.
         float sa = segLo;
-        for (uint piece = 0; piece <= 2u * nrel && sa < segHi; ++piece) {
+        for (uint piece = 0; piece <= 2u * nrel && sa < segHi; ++piece) { LOOP_EDGE();
             float sb = segHi;
-            for (uint i = 0; i < nrel; ++i) {
+            for (uint i = 0; i < nrel; ++i) { LOOP_EDGE();
                 vec3 q = all ? perturbationAlongRay(cellLists[cell.first + i], p, d) : relQ[i];
                 vec2 r = quadraticRoots(q);
                 if (r.x > sa && r.x < sb) sb = r.x;
@@ -235,7 +235,7 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
             // holds no root: the piece is passed without root isolation.
             vec2 range = quadraticRange(b, sa - sm, sb - sm);
             float size = max(abs(range.x), abs(range.y));
-            for (uint i = 0; i < nrel; ++i) {
+            for (uint i = 0; i < nrel; ++i) { LOOP_EDGE();
                 uint k = all ? cellLists[cell.first + i] : 0u;
                 vec3 q = shiftQuadratic(all ? perturbationAlongRay(k, p, d) : relQ[i], sm);
                 if (q.x > 0.0) {

@@ -83,7 +83,7 @@ float solveBracket(float c[7], float x0, float x1) {
     if (v0 == 0.0) return x0;
     bool rising = v0 < 0.0;
     float x = 0.5 * (x0 + x1);
-    for (int it = 0; it < 40; ++it) {
+    for (int it = 0; it < 40; ++it) { LOOP_EDGE();
         float v = evalPoly(c, x, slope);
         if (v == 0.0) return x;
         if ((v < 0.0) == rising) x0 = x; else x1 = x;
@@ -105,7 +105,7 @@ float firstRoot(float c[7], float lo, float hi) {
     // The current interval is [idx, idx + 1] / 2^level of [0, 1]; the walk is
     // a depth-first, left-first traversal of the binary subdivision tree.
     uint level = 0u, idx = 0u;
-    for (int it = 0; it < 160; ++it) {
+    for (int it = 0; it < 160; ++it) { LOOP_EDGE();
         float size = 1.0 / float(1u << level);
         float t0 = float(idx) * size, t1 = t0 + size;
         float b[7] = whole;
@@ -122,7 +122,7 @@ float firstRoot(float c[7], float lo, float hi) {
             continue;
         }
         // No root here (or only a touching one): go to the next interval.
-        while ((idx & 1u) == 1u) { idx >>= 1u; --level; }
+        while ((idx & 1u) == 1u) { LOOP_EDGE(); idx >>= 1u; --level; }
         if (level == 0u) return NO_ROOT;
         idx += 1u;
     }

@@ -27,7 +27,7 @@ MediaStack emptyStack() {
 // The index of refraction on the far side of material `m`'s surface.
 float farSideIor(MediaStack s, uint m, bool entering) {
     if (entering) return s.count > 0u ? materials[s.material[s.count - 1u]].ior : 1.0;
-    for (uint k = s.count; k > 0u; --k) {
+    for (uint k = s.count; k > 0u; --k) { LOOP_EDGE();
         if (s.material[k - 1u] == m) return k > 1u ? materials[s.material[k - 2u]].ior : 1.0;
     }
     return 1.0;
@@ -39,9 +39,9 @@ void crossInterface(inout MediaStack s, uint m, bool entering) {
         if (s.count < MEDIA_STACK) s.material[s.count++] = m;
         return;
     }
-    for (uint k = s.count; k > 0u; --k) {
+    for (uint k = s.count; k > 0u; --k) { LOOP_EDGE();
         if (s.material[k - 1u] == m) {
-            for (uint j = k - 1u; j + 1u < s.count; ++j) s.material[j] = s.material[j + 1u];
+            for (uint j = k - 1u; j + 1u < s.count; ++j) { LOOP_EDGE(); s.material[j] = s.material[j + 1u]; }
             --s.count;
             return;
         }

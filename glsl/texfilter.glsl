@@ -113,7 +113,7 @@ vec4 probeLookup(uint index, Footprint fp) {
     // weighted variance is exactly `rest` (with two probes: ±σ, weights ½).
     float weights[MAX_PROBES];
     float sw = 0.0, sv = 0.0;
-    for (int k = 0; k < n; ++k) {
+    for (int k = 0; k < n; ++k) { LOOP_EDGE();
         float o = (float(k) - 0.5 * float(n - 1)) * spacing;
         weights[k] = exp(-0.5 * o * o / rest);
         sw += weights[k];
@@ -122,7 +122,7 @@ vec4 probeLookup(uint index, Footprint fp) {
     float stretch = sqrt(rest * sw / max(sv, 1e-30));
     vec2 step = el.e1 / s0 * (spacing * stretch);
     vec4 sum = vec4(0.0);
-    for (int k = 0; k < n; ++k) {
+    for (int k = 0; k < n; ++k) { LOOP_EDGE();
         sum += weights[k] * textureLod(textures[nonuniformEXT(index)], fp.uv + (float(k) - 0.5 * float(n - 1)) * step, lod);
     }
     return sum / sw;
@@ -147,7 +147,7 @@ vec4 ewaLookup(uint index, Footprint fp) {
     // 4^L · 49/12 <= l2 + 1/4: the weights' σ (l2 + 1/6 - (4^L - 1)/12) at
     // least two texels of the level, 2^(L+1).
     float level = clamp(floor(0.5 * log2(max((el.l2 + 0.25) * 12.0 / 49.0, 1e-8))), 0.0, last);
-    while (level < last && 28.3 * sqrt((el.l1 + 0.25) * (el.l2 + 0.25)) / exp2(2.0 * level) > MAX_TAPS) level += 1.0;
+    while (level < last && 28.3 * sqrt((el.l1 + 0.25) * (el.l2 + 0.25)) / exp2(2.0 * level) > MAX_TAPS) { LOOP_EDGE(); level += 1.0; }
     int li = int(level);
     ivec2 size = max(size0 >> li, ivec2(1));
     if (size == ivec2(1)) return texelFetch(textures[nonuniformEXT(index)], ivec2(0), li);
@@ -162,8 +162,8 @@ vec4 ewaLookup(uint index, Footprint fp) {
     ivec2 lo = ivec2(floor(centre - radius)), hi = ivec2(ceil(centre + radius));
     vec4 sum = vec4(0.0);
     float weights = 0.0;
-    for (int y = lo.y; y <= hi.y; ++y) {
-        for (int x = lo.x; x <= hi.x; ++x) {
+    for (int y = lo.y; y <= hi.y; ++y) { LOOP_EDGE();
+        for (int x = lo.x; x <= hi.x; ++x) { LOOP_EDGE();
             vec2 dxy = vec2(x, y) - centre;
             float q = dot(dxy, inv * dxy);
             if (q > 9.0) continue;  // the Gaussian beyond 3σ (1% of its mass) is dropped

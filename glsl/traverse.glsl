@@ -21,7 +21,7 @@ vec3 proceedFunctional(rayQueryEXT rq, float tmin, float tmax) {
     float best = tmax;
     double best64 = double(tmax);
     vec3 bestPoint = vec3(0.0);
-    while (rayQueryProceedEXT(rq)) {
+    while (rayQueryProceedEXT(rq)) { LOOP_EDGE();
         if (rayQueryGetIntersectionTypeEXT(rq, false) != gl_RayQueryCandidateIntersectionAABBEXT) continue;
         uint object = candidateObject(rq, false);
         vec3 point;

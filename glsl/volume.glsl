@@ -50,7 +50,7 @@ vec3 scatteredAt(Medium fog, vec3 o, vec3 d, float t, uint i, inout uint rng) {
     vec3 x = o + t * d;
     vec3 sum = vec3(0.0);
     bool area = lights[i].kind == LIGHT_SPHERE || lights[i].kind == LIGHT_RECT;
-    [[dont_unroll]] for (uint strategy = 0u; strategy < (area ? 2u : 1u); ++strategy) {
+    [[dont_unroll]] for (uint strategy = 0u; strategy < (area ? 2u : 1u); ++strategy) { LOOP_EDGE();
         vec3 wi;
         float dist;
         vec3 contribution = vec3(0.0);
@@ -89,7 +89,7 @@ vec3 inScattered(Medium fog, vec3 o, vec3 d, float tEnd, uint i, inout uint rng)
     Equiangular e = equiangularSetup(o, d, tEnd, lightCentre(i));
     vec3 sum = vec3(0.0);
     // The two points in one loop: one call site of scatteredAt (above).
-    [[dont_unroll]] for (uint strategy = 0u; strategy < 2u; ++strategy) {
+    [[dont_unroll]] for (uint strategy = 0u; strategy < 2u; ++strategy) { LOOP_EDGE();
         float t, weight;
         bool valid;
         if (strategy == 0u) {
@@ -115,7 +115,7 @@ void volumePixel(uvec2 pix) {
     uint rng = seedRandom(pix, 0x5eed0000u + pc.firstSample, frame.seed);
     vec3 sum = vec3(0.0);
     uint side = max(uint(sqrt(float(pc.samples))), 1u);
-    for (uint s = 0u; s < pc.samples; ++s) {
+    for (uint s = 0u; s < pc.samples; ++s) { LOOP_EDGE();
         // Stratified within a dispatch (side x side strata, then random),
         // taken to the pixel filter (the render pass's Gaussian).
         vec2 u = s < side * side ? (vec2(s % side, s / side) + rand2(rng)) / float(side) : rand2(rng);
@@ -123,7 +123,7 @@ void volumePixel(uvec2 pix) {
         SceneHit h = traceScene(frame.eye, d, 0.0, 1e30);
         float tl;
         firstLightHit(frame.eye, d, h.object == NO_HIT ? 1e30 : h.t, frame.lightCount, tl);
-        for (uint i = 0u; i < frame.lightCount; ++i) {
+        for (uint i = 0u; i < frame.lightCount; ++i) { LOOP_EDGE();
             if (positionalLight(i)) sum += inScattered(fog, frame.eye, d, tl, i, rng);
         }
     }

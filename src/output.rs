@@ -131,6 +131,9 @@ pub const METADATA_EXPOSURE: &str = "quadray.exposure";
 pub const METADATA_SEED: &str = "quadray.seed";
 /// Metadata name: the frame number (renders of a frame range).
 pub const METADATA_FRAME: &str = "quadray.frame";
+/// Metadata name: the backend every tracing pass ran on (`ray-query` or
+/// `pipeline`).
+pub const METADATA_BACKEND: &str = "quadray.backend";
 /// Metadata name: the hash of the scene and the settings
 /// (`passes::checkpoint::render_key`, 16 hex digits); tiles merge only
 /// with tiles of the same.

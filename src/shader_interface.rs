@@ -171,6 +171,12 @@ pub const BINDING_RENDER_MAX_SAMPLE: u32 = 16;
 /// Descriptor binding of the recorded path vertices (render pass, when
 /// specialised to record one pixel's path).
 pub const BINDING_RENDER_PATH: u32 = 17;
+/// Descriptor binding of the loop-budget report (every tracing pass; see
+/// glsl/loop_budget.glsl).
+pub const BINDING_LOOP_BUDGET: u32 = 30;
+/// Specialisation constant id: 1 to measure the loop budget each tracing
+/// invocation leaves (glsl/loop_budget.glsl; off in renders).
+pub const SPEC_LOOP_BUDGET: u32 = 10;
 /// Vertices a recorded path holds at most.
 pub const PATH_RECORD_VERTICES: u32 = 96;
 /// Recorded path event: a surface scattering (a BSDF sample).

@@ -46,6 +46,9 @@ shaders! {
     caustic_beams,
     /// `glsl/volume.comp`: single scattering in the fog toward positional lights.
     volume,
+    /// `glsl/loop_budget.comp`: calibrates the loop-budget counter (a test
+    /// spends known back-edges, then reads the budget left).
+    loop_budget,
 }
 
 /// The stages of the ray-tracing-pipeline backend, compiled from

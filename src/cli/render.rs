@@ -156,15 +156,16 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
     }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
+    let backend = args.backend.resolve(&ctx.device)?;
     let variant = quadray::passes::RenderVariant {
         caustics: !args.brute_force,
         volume: !args.brute_force,
-        backend: args.backend.resolve(&ctx.device)?,
+        backend: Some(backend),
         ..Default::default()
     };
     let mut interrupted = false;
     if args.bench {
-        let out = bench(&ctx, &scene, variant.backend)?;
+        let out = bench(&ctx, &scene, backend)?;
         write_render(&args, &ctx, &scene, variant, &outputs, None, &out, quadray::job::JobEnd::Complete)?;
     } else {
         let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -249,6 +250,9 @@ pub(crate) fn write_render(
     if let Some(f) = frame {
         metadata.push((quadray::output::METADATA_FRAME.to_string(), f.to_string()));
     }
+    if let Some(b) = out.backend {
+        metadata.push((quadray::output::METADATA_BACKEND.to_string(), b.to_string()));
+    }
     write_outputs_with(out, &files, &metadata)?;
     let checkpoint = args.checkpoint.as_ref().or(args.resume.as_ref());
     match (end, checkpoint) {
@@ -328,18 +332,28 @@ pub(crate) fn bench(
     let variants = [
         (
             "full render",
-            RenderVariant { intersect: IntersectMode::Full, shading: ShadingMode::Full, backend, ..Default::default() },
+            RenderVariant {
+                intersect: IntersectMode::Full,
+                shading: ShadingMode::Full,
+                backend: Some(backend),
+                ..Default::default()
+            },
         ),
         (
             "perturbation root finding off",
-            RenderVariant { intersect: IntersectMode::Base, shading: ShadingMode::Full, backend, ..Default::default() },
+            RenderVariant {
+                intersect: IntersectMode::Base,
+                shading: ShadingMode::Full,
+                backend: Some(backend),
+                ..Default::default()
+            },
         ),
         (
             "shading and secondary rays off",
             RenderVariant {
                 intersect: IntersectMode::Full,
                 shading: ShadingMode::Albedo,
-                backend,
+                backend: Some(backend),
                 ..Default::default()
             },
         ),
@@ -348,7 +362,7 @@ pub(crate) fn bench(
             RenderVariant {
                 intersect: IntersectMode::Boxes,
                 shading: ShadingMode::Albedo,
-                backend,
+                backend: Some(backend),
                 ..Default::default()
             },
         ),
@@ -385,7 +399,7 @@ pub(crate) fn bench(
     // The full render on every backend the device offers, side by side.
     let mut by_backend = vec![(backend, rows[0].2)];
     for other in Backend::ALL.into_iter().filter(|&b| b != backend && device.offers(b)) {
-        let variant = RenderVariant { backend: other, ..variants[0].1 };
+        let variant = RenderVariant { backend: Some(other), ..variants[0].1 };
         quadray::passes::Renderer::warm_up(device, &mut cmds, &gpu, scene, variant)?;
         let out = render(device, &mut cmds, &gpu, scene, variant, &mut |_, _| {})?;
         by_backend.push((other, im.width as f64 * im.height as f64 * im.spp as f64 / out.seconds));

@@ -36,7 +36,7 @@ use crate::shader_interface::{
     SPEC_MEDIA_ENABLED,
 };
 use crate::vk::{
-    full_barrier, vk, Backend, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation,
+    Access, Backend, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation, ShaderStage,
 };
 use crate::{shaders, RenderError};
 
@@ -256,14 +256,18 @@ impl CausticMap {
         let beams = Buffer::storage(device, "beam map", pixels * 24, MemoryLocation::GpuToCpu)?;
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
         let intersect = gpu.intersect_mode(IntersectMode::Full).constant();
-        let traced = [(SPEC_INTERSECT_MODE, intersect)];
+        let traced = [(SPEC_INTERSECT_MODE, intersect), gpu.loop_budget_constant()];
         let gbuffer = Tracer::new(device, backend, shaders::gbuffer, shaders::gbuffer_rgen, &traced)?;
         let trace = Tracer::new(
             device,
             backend,
             shaders::caustic_trace,
             shaders::caustic_trace_rgen,
-            &[(SPEC_INTERSECT_MODE, intersect), (SPEC_MEDIA_ENABLED, u32::from(scene.has_media()))],
+            &[
+                (SPEC_INTERSECT_MODE, intersect),
+                (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),
+                gpu.loop_budget_constant(),
+            ],
         )?;
         let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &[])?;
         let beam = ComputePipeline::new(device, &shaders::caustic_beams(), &[])?;
@@ -300,54 +304,67 @@ impl CausticMap {
     pub fn run(&mut self, cmds: &mut Commands, timer: &GpuTimer) -> Result<(), RenderError> {
         let (width, height) = self.size;
         let Self { gbuffer, trace, splat, beam, map, beams, grids, report, .. } = self;
-        let ((), t) = timer.run(cmds, |d, cmd| {
-            unsafe {
-                d.cmd_fill_buffer(cmd, map.raw, 0, vk::WHOLE_SIZE, 0);
-                d.cmd_fill_buffer(cmd, beams.raw, 0, vk::WHOLE_SIZE, 0);
-            }
-            full_barrier(d, cmd);
-            gbuffer.run(cmd, &[], [width, height], [RENDER_GROUP, RENDER_GROUP]);
-            full_barrier(d, cmd);
+        // The tracing passes run in their backend's stage, splat and beams
+        // in compute shaders; the render pass (same backend) reads all.
+        let traced = gbuffer.stage();
+        let (tracing, compute) = (Access::ShaderWrite(traced), Access::ShaderWrite(ShaderStage::Compute));
+        let ((), t) = timer.run(cmds, |rec| {
+            // A previous run's render read the maps and the G-buffer, its
+            // splat and beams wrote the maps.
+            rec.barrier(&[Access::ShaderRead(traced), compute], &[Access::TransferWrite, tracing]);
+            map.fill(rec, 0);
+            beams.fill(rec, 0);
+            gbuffer.run(rec.cmd, &[], [width, height], [RENDER_GROUP, RENDER_GROUP]);
         })?;
         report.gbuffer_seconds = t;
 
-        let ((), t) = timer.run(cmds, |d, cmd| {
+        let ((), t) = timer.run(cmds, |rec| {
+            // The rays start from the G-buffer's receivers.
+            rec.barrier(&[tracing], &[tracing]);
             for g in grids.iter() {
                 trace.run(
-                    cmd,
+                    rec.cmd,
                     bytemuck::bytes_of(&CausticPush { emitter: *g }),
                     [g.grid[0] * g.grid[1], 1],
                     [CAUSTIC_GROUP, 1],
                 );
             }
-            full_barrier(d, cmd);
         })?;
         report.trace_seconds = t;
 
-        let ((), t) = timer.run(cmds, |d, cmd| {
-            for g in grids.iter() {
+        let ((), t) = timer.run(cmds, |rec| {
+            // Splats read the rays and add into the cleared map; each
+            // grid's splats add into the same pixels as the last grid's.
+            rec.barrier(&[tracing, Access::TransferWrite], &[compute]);
+            for (i, g) in grids.iter().enumerate() {
+                if i > 0 {
+                    rec.barrier(&[compute], &[compute]);
+                }
                 let cells = (g.grid[0] - 1) * (g.grid[1] - 1);
                 splat.dispatch(
-                    cmd,
+                    rec.cmd,
                     bytemuck::bytes_of(&CausticPush { emitter: *g }),
                     [cells.div_ceil(CAUSTIC_GROUP), 1, 1],
                 );
             }
-            full_barrier(d, cmd);
         })?;
         report.splat_seconds = t;
 
         if self.has_beams {
-            let ((), t) = timer.run(cmds, |d, cmd| {
-                for g in grids.iter() {
+            let ((), t) = timer.run(cmds, |rec| {
+                // Beams read the rays and add into the cleared beam map.
+                rec.barrier(&[tracing, Access::TransferWrite, compute], &[compute]);
+                for (i, g) in grids.iter().enumerate() {
+                    if i > 0 {
+                        rec.barrier(&[compute], &[compute]);
+                    }
                     let count = ((g.grid[0] - 1) / BEAM_STRIDE) * ((g.grid[1] - 1) / BEAM_STRIDE);
                     beam.dispatch(
-                        cmd,
+                        rec.cmd,
                         bytemuck::bytes_of(&CausticPush { emitter: *g }),
                         [count.div_ceil(CAUSTIC_GROUP).max(1), 1, 1],
                     );
                 }
-                full_barrier(d, cmd);
             })?;
             report.beam_seconds = t;
         }

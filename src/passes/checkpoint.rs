@@ -83,6 +83,7 @@ impl Accumulation {
             volume_seconds: None,
             dropped_samples,
             max_sample: self.max_sample,
+            backend: None,
         }
     }
 }

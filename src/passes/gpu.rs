@@ -580,6 +580,29 @@ pub struct GpuPathRecord {
     pub vertices: [GpuPathVertex; crate::shader_interface::PATH_RECORD_VERTICES as usize],
 }
 
+/// `LoopBudget` in loop_budget.glsl: the loop iterations the tracing
+/// invocations counted ([`crate::passes::LoopBudget`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLoopBudget {
+    /// The most loop iterations one invocation counted.
+    pub most_edges: u32,
+    /// Invocations that reported.
+    pub invocations: u32,
+    /// loop_budget.comp: how far its uncounted loop ran.
+    pub spent: u32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// `Push` in loop_budget.comp: the loop iterations to spend.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct LoopBudgetPush {
+    /// Loop iterations to spend.
+    pub spend: u32,
+}
+
 /// `Push` in the caustic shaders: the grid being traced.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -622,6 +645,8 @@ pub fn host_layouts() -> Vec<HostLayout> {
         host_layout!(GpuCausticRay as "CausticRay" { position, object, flux, path, beam_start, in_fog }),
         host_layout!(GpuReceiver as "Receiver" { position, object }),
         host_layout!(GpuEmitter as "Emitter" { origin, kind, u, first_ray, v, max_specular, w, pad, lo, hi, grid, power }),
+        host_layout!(GpuLoopBudget as "LoopBudget" { most_edges, invocations, spent, pad }),
+        host_layout!(LoopBudgetPush as "Push" in ["loop_budget"] { spend }),
         host_layout!(RenderPush as "Push" in ["render"] { tile_origin, tile_size, sample_index, write_aov }),
         host_layout!(ProbePush as "Push" in ["probe", "texprobe"] { first, count }),
         host_layout!(VolumePush as "Push" in ["volume"] { first_sample, samples, total }),

@@ -19,7 +19,7 @@ pub use caustics::{CausticMap, CausticReport};
 pub use checkpoint::{Accumulation, Checkpoint};
 pub use probe::ProbePass;
 pub use render::{render, RecordedPath, RenderOutput, Renderer};
-pub use scene_gpu::{GeometryStats, GpuScene};
+pub use scene_gpu::{GeometryStats, GpuScene, LoopBudget, LOOP_LIMIT};
 pub use texprobe::TexProbePass;
 pub use tracer::Tracer;
 pub use variant::{IntersectMode, LookupMode, RenderVariant, ShadingMode};

@@ -10,7 +10,9 @@ use super::IntersectMode;
 use crate::shader_interface::{
     BINDING_PROBE_HITS, BINDING_PROBE_RAYS, PROBE_GROUP, SPEC_INTERSECT_MODE, SPEC_PROBE_CURVATURE,
 };
-use crate::vk::{vk, Backend, Binding, Buffer, Commands, Device, MemoryLocation, Timestamps};
+use crate::vk::{
+    vk, Access, Backend, Binding, Buffer, Commands, Device, MemoryLocation, Recording, ShaderStage, Timestamps,
+};
 use crate::{shaders, RenderError};
 
 /// Rays per dispatch: short enough never to trip a driver watchdog.
@@ -36,7 +38,7 @@ impl ProbePass {
         mode: IntersectMode,
         curvature: bool,
     ) -> Result<Self, RenderError> {
-        Self::with_backend(device, scene, rays, mode, curvature, Backend::RayQuery)
+        Self::with_backend(device, scene, rays, mode, curvature, device.backend_for(None)?)
     }
 
     /// [`ProbePass::new`] tracing with `backend`: ray queries (`probe.comp`)
@@ -49,7 +51,11 @@ impl ProbePass {
         curvature: bool,
         backend: Backend,
     ) -> Result<Self, RenderError> {
-        let spec = [(SPEC_INTERSECT_MODE, mode.constant()), (SPEC_PROBE_CURVATURE, u32::from(curvature))];
+        let spec = [
+            (SPEC_INTERSECT_MODE, mode.constant()),
+            (SPEC_PROBE_CURVATURE, u32::from(curvature)),
+            scene.loop_budget_constant(),
+        ];
         let tracer = Tracer::new(device, backend, shaders::probe, shaders::probe_rgen, &spec)?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::storage(
@@ -68,22 +74,41 @@ impl ProbePass {
 
     /// Traces every ray; returns the hits and the GPU time in nanoseconds.
     pub fn run(&self, cmds: &mut Commands) -> Result<(Vec<GpuHit>, f64), RenderError> {
-        let _ = &self.rays;
-        cmds.run(|_, cmd| {
-            self.timestamps.reset(cmd);
-            self.timestamps.write(cmd, 0);
-            let mut first = 0;
-            while first < self.count {
-                let n = (self.count - first).min(RAYS_PER_DISPATCH);
-                let push = ProbePush { first, count: n };
-                self.tracer.run(cmd, bytemuck::bytes_of(&push), [n, 1], [PROBE_GROUP, 1]);
-                first += n;
-            }
-            self.timestamps.write(cmd, 1);
+        let written = [Access::ShaderWrite(self.stage())];
+        cmds.run(|rec| {
+            // An earlier run wrote the same hits.
+            rec.barrier(&written, &written);
+            self.record(rec);
         })?;
         let ts = self.timestamps.read_ns()?;
         let mut hits: Vec<GpuHit> = self.hits.read();
         hits.truncate(self.count as usize);
         Ok((hits, ts[1] - ts[0]))
+    }
+
+    /// Records the pass into `rec` (timestamps around the dispatches),
+    /// with no barrier: the caller orders it after what came before.
+    pub fn record(&self, rec: Recording<'_>) {
+        let _ = &self.rays;
+        self.timestamps.reset(rec.cmd);
+        self.timestamps.write(rec.cmd, 0);
+        let mut first = 0;
+        while first < self.count {
+            let n = (self.count - first).min(RAYS_PER_DISPATCH);
+            let push = ProbePush { first, count: n };
+            self.tracer.run(rec.cmd, bytemuck::bytes_of(&push), [n, 1], [PROBE_GROUP, 1]);
+            first += n;
+        }
+        self.timestamps.write(rec.cmd, 1);
+    }
+
+    /// The shader stage the pass runs in (its backend's).
+    pub fn stage(&self) -> ShaderStage {
+        self.tracer.stage()
+    }
+
+    /// The hits buffer the pass writes (`GpuHit` per ray).
+    pub fn hits(&self) -> &Buffer {
+        &self.hits
     }
 }

@@ -19,7 +19,7 @@ use crate::shader_interface::{
     RENDER_GROUP, SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED, SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE,
     SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
 };
-use crate::vk::{full_barrier, vk, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation};
+use crate::vk::{vk, Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation, ShaderStage};
 use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
@@ -64,6 +64,9 @@ pub struct RenderOutput {
     /// (empty for an image read from a file). The outlier report compares it
     /// with the bound the scene allows (`passes::outliers`).
     pub max_sample: Vec<[f32; 2]>,
+    /// The backend every tracing pass ran on (`None` for an image read from
+    /// a file).
+    pub backend: Option<Backend>,
 }
 
 impl RenderOutput {
@@ -84,6 +87,7 @@ impl RenderOutput {
             volume_seconds: None,
             dropped_samples: 0,
             max_sample: vec![],
+            backend: None,
         }
     }
 }
@@ -284,6 +288,8 @@ impl Renderer {
         variant: RenderVariant,
     ) -> Result<Self, RenderError> {
         let bounds = bounds.check(width, height)?;
+        // One backend for every tracing pass, resolved once.
+        let backend = device.backend_for(variant.backend)?;
         let pixels = width as u64 * height as u64;
         let frame = Buffer::with_data(
             device,
@@ -291,9 +297,9 @@ impl Renderer {
             &[gpu_frame(scene, gpu, width, height, spp)],
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )?;
-        let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant)?;
+        let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant, backend)?;
         let volume = if variant.volume && variant.shading == ShadingMode::Full && scene.needs_volume() {
-            Some(VolumeLight::new(device, gpu, &frame, (width, height), variant.backend)?)
+            Some(VolumeLight::new(device, gpu, &frame, (width, height), backend)?)
         } else {
             None
         };
@@ -316,7 +322,7 @@ impl Renderer {
         // The recorded path (`GpuPathRecord`): a count, then the vertices.
         let path_bytes = std::mem::size_of::<GpuPathRecord>() as u64;
         let path = Buffer::storage(device, "recorded path", path_bytes, MemoryLocation::GpuToCpu)?;
-        let pipeline = render_pipeline(device, gpu, scene, variant, caustics.as_ref(), volume.is_some())?;
+        let pipeline = render_pipeline(device, gpu, scene, (variant, backend), caustics.as_ref(), volume.is_some())?;
         {
             let receivers = caustics.as_ref().map_or(&placeholder, |c| &c.receivers);
             let caustic_map = caustics.as_ref().map_or(&placeholder, |c| &c.map);
@@ -337,9 +343,12 @@ impl Renderer {
             ]);
             pipeline.bind(&bindings)?;
         }
-        cmds.run(|_, cmd| {
-            accum.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
-            max_sample.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL);
+        // Cleared next (restart), then written by the samples.
+        let first_use = [Access::TransferWrite];
+        cmds.run(|rec| {
+            for image in [&accum, &max_sample] {
+                image.transition(rec, (&[], vk::ImageLayout::UNDEFINED), (&first_use, vk::ImageLayout::GENERAL));
+            }
         })?;
         let PixelBounds { x0, x1, y0, y1 } = bounds;
         let tiles = (y0..y1)
@@ -391,10 +400,12 @@ impl Renderer {
             v.run(cmds, &self.timer, self.volume_samples)?;
         }
         let (accum, max_sample) = (&self.accum, &self.max_sample);
-        cmds.run(|d, cmd| {
-            full_barrier(d, cmd);
-            accum.clear(cmd);
-            max_sample.clear(cmd);
+        // The last samples read and wrote the images the clear overwrites.
+        let samples = [Access::ShaderWrite(self.pipeline.stage())];
+        cmds.run(|rec| {
+            rec.barrier(&samples, &[Access::TransferWrite]);
+            accum.clear(rec.cmd);
+            max_sample.clear(rec.cmd);
         })?;
         self.samples = 0;
         self.tiles_done = 0;
@@ -459,10 +470,13 @@ impl Renderer {
                 write_aov: (self.samples == 0) as u32,
             };
             let pipeline = &self.pipeline;
-            let ((), seconds) = self.timer.run(cmds, |d, cmd| {
-                // Earlier submissions' writes to the accumulation image must be visible.
-                full_barrier(d, cmd);
-                pipeline.run(cmd, bytemuck::bytes_of(&push), [t[2], t[3]], [RENDER_GROUP, RENDER_GROUP])
+            let sample = [Access::ShaderWrite(pipeline.stage())];
+            let ((), seconds) = self.timer.run(cmds, |rec| {
+                // What earlier submissions wrote must be visible: the clear
+                // (or a restored accumulation), the caustic and volume
+                // passes (compute or the tracing stage), the last sample.
+                rec.barrier(&[Access::TransferWrite, Access::ShaderWrite(ShaderStage::Compute), sample[0]], &sample);
+                pipeline.run(rec.cmd, bytemuck::bytes_of(&push), [t[2], t[3]], [RENDER_GROUP, RENDER_GROUP])
             })?;
             self.render_seconds += seconds;
             self.tiles_done += 1;
@@ -569,14 +583,22 @@ impl Renderer {
         staging.write(0, bytemuck::cast_slice(&sums));
         staging.write(pixels * 16, bytemuck::cast_slice(&largest));
         let (accum, max_sample) = (&self.accum, &self.max_sample);
-        cmds.run(|d, cmd| {
-            full_barrier(d, cmd);
+        let samples = [Access::ShaderWrite(self.pipeline.stage())];
+        let upload = [Access::TransferWrite];
+        cmds.run(|rec| {
             for (image, offset) in [(accum, 0), (max_sample, pixels as u64 * 16)] {
-                image.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
-                image.copy_from_buffer(cmd, &staging, &[image.rows_region(0, 0, height, offset)]);
-                image.transition(cmd, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::GENERAL);
+                image.transition(
+                    rec,
+                    (&samples, vk::ImageLayout::GENERAL),
+                    (&upload, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+                );
+                image.copy_from_buffer(rec.cmd, &staging, &[image.rows_region(0, 0, height, offset)]);
+                image.transition(
+                    rec,
+                    (&upload, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+                    (&samples, vk::ImageLayout::GENERAL),
+                );
             }
-            full_barrier(d, cmd);
         })?;
         self.samples = acc.samples;
         self.tiles_done = acc.partial_tiles as usize;
@@ -599,12 +621,15 @@ impl Renderer {
     /// longer than the image (the buffer fits the largest of them).
     fn read_image<T: bytemuck::Pod>(&self, cmds: &mut Commands, image: &Image) -> Result<Vec<T>, RenderError> {
         let readback = &self.readback;
-        cmds.run(|d, cmd| {
-            full_barrier(d, cmd);
-            image.transition(cmd, vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-            image.copy_to_buffer(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback);
-            image.transition(cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL);
-            full_barrier(d, cmd);
+        let samples = [Access::ShaderWrite(self.pipeline.stage())];
+        let copy = [Access::TransferRead];
+        cmds.run(|rec| {
+            // The last read-back's copy wrote the buffer (its host read
+            // came after the fence).
+            rec.barrier(&[Access::TransferWrite], &[Access::TransferWrite]);
+            image.transition(rec, (&samples, vk::ImageLayout::GENERAL), (&copy, vk::ImageLayout::TRANSFER_SRC_OPTIMAL));
+            image.copy_to_buffer(rec.cmd, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, readback);
+            image.transition(rec, (&copy, vk::ImageLayout::TRANSFER_SRC_OPTIMAL), (&samples, vk::ImageLayout::GENERAL));
         })?;
         Ok(readback.read())
     }
@@ -617,6 +642,7 @@ impl Renderer {
             caustics: self.caustics.as_ref().map(|c| CausticReport { irradiance: Vec::new(), ..c.report.clone() }),
             volume_seconds: self.volume_seconds(),
             seconds: self.seconds(),
+            backend: Some(self.pipeline.backend()),
             ..acc.into_output(&self.sample_counts())
         })
     }
@@ -636,10 +662,10 @@ impl Renderer {
         self.path.write(0, &[0u8; 4]);
         let push = RenderPush { tile_origin: [x, y], tile_size: [1, 1], sample_index: sample, write_aov: 0 };
         let pipeline = &self.pipeline;
-        cmds.run(|d, cmd| {
-            full_barrier(d, cmd);
-            pipeline.run(cmd, bytemuck::bytes_of(&push), [1, 1], [1, 1]);
-            full_barrier(d, cmd);
+        let sample = [Access::ShaderWrite(pipeline.stage())];
+        cmds.run(|rec| {
+            rec.barrier(&[Access::TransferWrite, Access::ShaderWrite(ShaderStage::Compute), sample[0]], &sample);
+            pipeline.run(rec.cmd, bytemuck::bytes_of(&push), [1, 1], [1, 1]);
         })?;
         let bytes: Vec<u8> = self.path.read();
         let total = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
@@ -656,17 +682,18 @@ fn render_pipeline(
     device: &Arc<Device>,
     gpu: &GpuScene,
     scene: &Scene,
-    variant: RenderVariant,
+    (variant, backend): (RenderVariant, Backend),
     caustics: Option<&CausticMap>,
     volume: bool,
 ) -> Result<Tracer, RenderError> {
     Ok(Tracer::new(
         device,
-        variant.backend,
+        backend,
         shaders::render,
         shaders::render_rgen,
         &[
             (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect).constant()),
+            gpu.loop_budget_constant(),
             (SPEC_SHADING_MODE, variant.shading.constant()),
             (SPEC_FILTER_MODE, scene.image.filter.constant()),
             (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),
@@ -690,6 +717,7 @@ fn caustic_map(
     frame: &Buffer,
     size: (u32, u32),
     variant: RenderVariant,
+    backend: Backend,
 ) -> Result<Option<CausticMap>, RenderError> {
     let max_depth = scene.image.max_depth.max(1);
     if !variant.caustics || variant.shading != ShadingMode::Full || !scene.needs_caustics() || max_depth < 2 {
@@ -719,7 +747,7 @@ fn caustic_map(
             fewer
         );
     }
-    Ok(Some(CausticMap::new(device, gpu, scene, frame, size, &grids, variant.backend)?))
+    Ok(Some(CausticMap::new(device, gpu, scene, frame, size, &grids, backend)?))
 }
 
 #[cfg(test)]

@@ -6,18 +6,18 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DMat3, DVec3};
 
-use super::gpu::{GpuCell, GpuLight, GpuMaterial, GpuObject, GpuPerturbation};
+use super::gpu::{GpuCell, GpuLight, GpuLoopBudget, GpuMaterial, GpuObject, GpuPerturbation};
 use super::IntersectMode;
 use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Light, Scene, TextureImage};
 use crate::shader_interface::{
-    BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_MATERIALS, BINDING_OBJECTS,
-    BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE,
+    BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_LOOP_BUDGET, BINDING_MATERIALS,
+    BINDING_OBJECTS, BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE, SPEC_LOOP_BUDGET,
 };
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::texture::scene_maps;
-use crate::vk::{vk, AccelerationStructure, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
+use crate::vk::{vk, AccelerationStructure, Access, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
 use crate::RenderError;
 
 /// Sizes of what a scene put on the GPU.
@@ -69,6 +69,28 @@ pub struct GpuScene {
     pub stats: GeometryStats,
     /// The world point at the GPU frame's origin ([`Self::with_origin`]).
     pub origin: DVec3,
+    /// The loop-budget report every tracing pass binds (`GpuLoopBudget`).
+    loop_budget: Buffer,
+    /// Whether passes built from now on measure the loop budget.
+    measure_loop_budget: bool,
+}
+
+/// Loop back-edges Mesa 25.0's gallivm source allows one shader invocation
+/// (a vector of lanes) in all its loops before it silently leaves them
+/// (`LP_MAX_TGSI_LOOP_ITERATIONS`; Mesa 25.1 removed the limit). The
+/// loop-budget test measures whether the installed driver applies it.
+pub const LOOP_LIMIT: u32 = 65_535;
+
+/// The loop iterations the tracing invocations counted
+/// (glsl/loop_budget.glsl) since [`GpuScene::reset_loop_budget`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoopBudget {
+    /// The most loop iterations one invocation counted.
+    pub most_edges: u32,
+    /// Invocations that reported.
+    pub invocations: u32,
+    /// loop_budget.comp only: how far its uncounted loop ran.
+    pub spent: u32,
 }
 
 /// Host-visible memory a texture upload stages at most at once: larger maps
@@ -146,7 +168,10 @@ pub fn upload_texture(
         vk::BufferUsageFlags::TRANSFER_SRC,
         gpu_allocator::MemoryLocation::CpuToGpu,
     )?;
-    cmds.run(|_, cmd| image.transition(cmd, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL))?;
+    let upload = [Access::TransferWrite];
+    cmds.run(|rec| {
+        image.transition(rec, (&[], vk::ImageLayout::UNDEFINED), (&upload, vk::ImageLayout::TRANSFER_DST_OPTIMAL))
+    })?;
     let mut regions = Vec::new();
     let mut used = 0u64;
     for (level, texels) in t.levels.iter().enumerate() {
@@ -157,7 +182,10 @@ pub fn upload_texture(
         while row < height {
             let rows = (height - row).min((staging_size - used) / row_bytes);
             if rows == 0 {
-                cmds.run(|_, cmd| image.copy_from_buffer(cmd, &staging, &regions))?;
+                // Copies into other rows than the last submission's: no
+                // dependency between them (the staging buffer is rewritten
+                // by the host only after the fence).
+                cmds.run(|rec| image.copy_from_buffer(rec.cmd, &staging, &regions))?;
                 (regions, used) = (Vec::new(), 0);
                 continue;
             }
@@ -169,9 +197,15 @@ pub fn upload_texture(
             row += rows;
         }
     }
-    cmds.run(|_, cmd| {
-        image.copy_from_buffer(cmd, &staging, &regions);
-        image.transition(cmd, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+    // Sampled by whichever shader stage a pass runs in.
+    let readers: Vec<Access> = device.shader_stages().iter().map(|&s| Access::ShaderRead(s)).collect();
+    cmds.run(|rec| {
+        image.copy_from_buffer(rec.cmd, &staging, &regions);
+        image.transition(
+            rec,
+            (&upload, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+            (&readers, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+        );
     })?;
     Ok(image)
 }
@@ -255,6 +289,14 @@ fn row_major_3x4(m: &DAffine3) -> [f32; 12] {
 
 fn storage(device: &Arc<Device>, name: &str, bytes: &[u8]) -> Result<Buffer, RenderError> {
     Ok(Buffer::with_data(device, name, bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?)
+}
+
+/// The loop-budget report, cleared.
+fn loop_budget_buffer(device: &Arc<Device>) -> Result<Buffer, RenderError> {
+    let size = std::mem::size_of::<GpuLoopBudget>() as u64;
+    let mut buffer = Buffer::storage(device, "loop budget", size, gpu_allocator::MemoryLocation::GpuToCpu)?;
+    buffer.write(0, bytemuck::bytes_of(&GpuLoopBudget::default()));
+    Ok(buffer)
 }
 
 impl GpuScene {
@@ -394,7 +436,35 @@ impl GpuScene {
             _blases: blases,
             stats,
             origin,
+            loop_budget: loop_budget_buffer(device)?,
+            measure_loop_budget: false,
         })
+    }
+
+    /// Turns the loop-budget measurement on or off for the passes built
+    /// after this call (their shaders are specialised for it) and clears
+    /// the report.
+    pub fn measure_loop_budget(&mut self, on: bool) {
+        self.measure_loop_budget = on;
+        self.reset_loop_budget();
+    }
+
+    /// Clears the loop-budget report.
+    pub fn reset_loop_budget(&mut self) {
+        self.loop_budget.write(0, bytemuck::bytes_of(&GpuLoopBudget::default()));
+    }
+
+    /// What the invocations of passes built with the measurement on counted
+    /// since the last reset (read after their work).
+    pub fn loop_budget(&self) -> LoopBudget {
+        let r: GpuLoopBudget = self.loop_budget.read()[0];
+        LoopBudget { most_edges: r.most_edges, invocations: r.invocations, spent: r.spent }
+    }
+
+    /// The specialisation constant every tracing pass takes from the scene:
+    /// whether it measures the loop budget.
+    pub fn loop_budget_constant(&self) -> (u32, u32) {
+        (SPEC_LOOP_BUDGET, u32::from(self.measure_loop_budget))
     }
 
     /// The texture array: every scene texture, the rest of the slots filled
@@ -431,9 +501,11 @@ impl GpuScene {
         bindings
     }
 
-    /// The bindings `BINDING_TLAS..=BINDING_CELL_LISTS` shared by all passes.
-    pub fn geometry_bindings(&self) -> [(u32, Binding<'_>); 5] {
+    /// The bindings `BINDING_TLAS..=BINDING_CELL_LISTS` shared by all
+    /// passes, and the loop-budget report.
+    pub fn geometry_bindings(&self) -> [(u32, Binding<'_>); 6] {
         [
+            (BINDING_LOOP_BUDGET, Binding::Buffer(&self.loop_budget)),
             (BINDING_TLAS, Binding::AccelerationStructure(&self.tlas)),
             (BINDING_OBJECTS, Binding::Buffer(&self.objects)),
             (BINDING_CELLS, Binding::Buffer(&self.cells)),

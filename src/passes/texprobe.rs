@@ -8,7 +8,7 @@ use super::gpu::{GpuTexQuery, GpuTexResult, ProbePush};
 use super::scene_gpu::GpuScene;
 use super::LookupMode;
 use crate::shader_interface::{BINDING_TEXPROBE_QUERIES, BINDING_TEXPROBE_RESULTS, PROBE_GROUP, SPEC_LOOKUP_MODE};
-use crate::vk::{vk, Binding, Buffer, Commands, ComputePipeline, Device, MemoryLocation};
+use crate::vk::{vk, Access, Binding, Buffer, Commands, ComputePipeline, Device, MemoryLocation, ShaderStage};
 use crate::{shaders, RenderError};
 
 /// Lookups per dispatch.
@@ -53,12 +53,15 @@ impl TexProbePass {
 
     /// Runs every lookup and returns the results in query order.
     pub fn run(&self, cmds: &mut Commands) -> Result<Vec<GpuTexResult>, RenderError> {
-        cmds.run(|_, cmd| {
+        let written = [Access::ShaderWrite(ShaderStage::Compute)];
+        cmds.run(|rec| {
+            // An earlier run wrote the same results.
+            rec.barrier(&written, &written);
             let mut first = 0;
             while first < self.count {
                 let n = (self.count - first).min(QUERIES_PER_DISPATCH);
                 let push = ProbePush { first, count: n };
-                self.pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [n.div_ceil(PROBE_GROUP), 1, 1]);
+                self.pipeline.dispatch(rec.cmd, bytemuck::bytes_of(&push), [n.div_ceil(PROBE_GROUP), 1, 1]);
                 first += n;
             }
         })?;

@@ -8,7 +8,9 @@
 use std::sync::Arc;
 
 use crate::shaders;
-use crate::vk::{vk, Backend, Binding, ComputePipeline, Device, RayTracingPipeline, RayTracingStages, VkError};
+use crate::vk::{
+    vk, Backend, Binding, ComputePipeline, Device, RayTracingPipeline, RayTracingStages, ShaderStage, VkError,
+};
 
 /// A pass's shader on one backend.
 pub enum Tracer {
@@ -22,8 +24,8 @@ impl Tracer {
     /// The pass's pipeline for `backend`: the compute shader `compute`, or
     /// the ray-generation shader `raygen` with the shared miss,
     /// intersection and closest-hit stages; `specialization` as
-    /// [`ComputePipeline::new`]. On a device without ray queries every pass
-    /// takes the pipeline.
+    /// [`ComputePipeline::new`]. A backend the device was not created with is
+    /// an error ([`VkError::BackendUnavailable`]), not a fallback.
     pub fn new(
         device: &Arc<Device>,
         backend: Backend,
@@ -31,7 +33,7 @@ impl Tracer {
         raygen: fn() -> Vec<u32>,
         specialization: &[(u32, u32)],
     ) -> Result<Self, VkError> {
-        let backend = if device.offers(Backend::RayQuery) { backend } else { Backend::Pipeline };
+        let backend = device.backend_for(Some(backend))?;
         Ok(match backend {
             Backend::RayQuery => Tracer::RayQuery(ComputePipeline::new(device, &compute(), specialization)?),
             Backend::Pipeline => {
@@ -44,6 +46,19 @@ impl Tracer {
                 Tracer::Pipeline(RayTracingPipeline::new(device, &stages, specialization)?)
             }
         })
+    }
+
+    /// The backend that runs the pass.
+    pub fn backend(&self) -> Backend {
+        match self {
+            Tracer::RayQuery(_) => Backend::RayQuery,
+            Tracer::Pipeline(_) => Backend::Pipeline,
+        }
+    }
+
+    /// The shader stage whose accesses the pass's barriers name.
+    pub fn stage(&self) -> ShaderStage {
+        self.backend().into()
     }
 
     /// Points the shader's bindings at resources.

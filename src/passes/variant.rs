@@ -106,8 +106,11 @@ pub struct RenderVariant {
     pub lookup: LookupMode,
     /// How every tracing pass (render, caustic G-buffer and rays, volume)
     /// traces rays: ray queries, or a ray-tracing pipeline with the
-    /// intersection shader.
-    pub backend: Backend,
+    /// intersection shader. `None` takes the device's preferred one
+    /// ([`Device::backend_for`](crate::vk::Device::backend_for)); a backend
+    /// asked for that the device lacks is an error, never a fallback.
+    /// [`RenderOutput::backend`](super::RenderOutput::backend) says which ran.
+    pub backend: Option<Backend>,
 }
 
 impl Default for RenderVariant {
@@ -119,7 +122,7 @@ impl Default for RenderVariant {
             volume: true,
             record_path: false,
             lookup: LookupMode::Probes,
-            backend: Backend::RayQuery,
+            backend: None,
         }
     }
 }

@@ -12,7 +12,7 @@ use super::scene_gpu::GpuScene;
 use super::tracer::Tracer;
 use super::IntersectMode;
 use crate::shader_interface::{BINDING_VOLUME, RENDER_GROUP, SPEC_INTERSECT_MODE};
-use crate::vk::{full_barrier, vk, Backend, Binding, Buffer, Commands, Device, GpuTimer, MemoryLocation};
+use crate::vk::{Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, MemoryLocation};
 use crate::{shaders, RenderError};
 
 /// Camera rays per pixel in one dispatch of the volume pass.
@@ -48,7 +48,7 @@ impl VolumeLight {
             backend,
             shaders::volume,
             shaders::volume_rgen,
-            &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant())],
+            &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant()), gpu.loop_budget_constant()],
         )?;
         let mut bindings = gpu.frame_bindings(frame);
         bindings.push((BINDING_VOLUME, Binding::Buffer(&radiance)));
@@ -61,14 +61,19 @@ impl VolumeLight {
     pub fn run(&mut self, cmds: &mut Commands, timer: &GpuTimer, samples: u32) -> Result<(), RenderError> {
         let (width, height) = self.size;
         let radiance = &self.radiance;
-        let ((), mut seconds) =
-            timer.run(cmds, |d, cmd| unsafe { d.cmd_fill_buffer(cmd, radiance.raw, 0, vk::WHOLE_SIZE, 0) })?;
+        let stage = self.pipeline.stage();
+        let batch = [Access::ShaderWrite(stage)];
+        // The render pass (same backend) read the last run's radiance.
+        let ((), mut seconds) = timer.run(cmds, |rec| {
+            rec.barrier(&[Access::ShaderRead(stage)], &[Access::TransferWrite]);
+            radiance.fill(rec, 0);
+        })?;
         for first in (0..samples).step_by(BATCH as usize) {
             let push = VolumePush { first_sample: first, samples: BATCH.min(samples - first), total: samples };
-            let ((), t) = timer.run(cmds, |d, cmd| {
-                full_barrier(d, cmd);
-                self.pipeline.run(cmd, bytemuck::bytes_of(&push), [width, height], [RENDER_GROUP, RENDER_GROUP]);
-                full_barrier(d, cmd);
+            let ((), t) = timer.run(cmds, |rec| {
+                // Each batch adds to what the fill or the last batch left.
+                rec.barrier(&[Access::TransferWrite, batch[0]], &batch);
+                self.pipeline.run(rec.cmd, bytemuck::bytes_of(&push), [width, height], [RENDER_GROUP, RENDER_GROUP]);
             })?;
             seconds += t;
         }

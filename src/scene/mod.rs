@@ -10,6 +10,9 @@ use glam::{DAffine3, DVec2, DVec3, Vec3};
 use crate::geometry::FunctionalObject;
 
 pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME, MAX_IMAGE_SIZE};
+
+/// The longest path a scene may ask for (`image.max_depth`).
+pub const MAX_DEPTH: u32 = file::MAX_DEPTH as u32;
 pub use preset::{FilterMode, Preset, Quality};
 
 /// A pinhole camera.

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::{full_barrier, Buffer, Commands, Device, VkError};
+use super::{Access, Buffer, Commands, Device, VkError};
 
 /// An acceleration structure and the buffer that stores it.
 pub struct AccelerationStructure {
@@ -87,9 +87,16 @@ impl AccelerationStructure {
             .dst_acceleration_structure(raw)
             .scratch_data(vk::DeviceOrHostAddressKHR { device_address: scratch_address });
         let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(primitive_count)];
-        cmds.run(|d, cmd| {
-            unsafe { device.accel.cmd_build_acceleration_structures(cmd, &[build_info], &[&range]) };
-            full_barrier(d, cmd);
+        // The build's inputs are host writes, which the submission makes
+        // visible; what reads the structure next is a build (a TLAS over
+        // this BLAS) or a trace in any stage the device runs.
+        let mut next = vec![Access::AccelerationStructureBuild];
+        next.extend(device.shader_stages().iter().map(|&s| Access::Trace(s)));
+        cmds.run(|rec| {
+            // SAFETY: the build's structures and scratch buffer live until
+            // the submission has finished (run waits on its fence).
+            unsafe { device.accel.cmd_build_acceleration_structures(rec.cmd, &[build_info], &[&range]) };
+            rec.barrier(&[Access::AccelerationStructureBuild], &next);
         })?;
         Ok(this)
     }

@@ -6,7 +6,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
-use super::{Device, VkError};
+use super::{Device, Recording, VkError};
 
 /// A buffer and its memory, freed on drop.
 pub struct Buffer {
@@ -20,7 +20,7 @@ pub struct Buffer {
 
 impl Buffer {
     /// A storage buffer of `size` bytes in `location`, which transfers can
-    /// also fill (`cmd_fill_buffer`).
+    /// also fill ([`Buffer::fill`]).
     pub fn storage(device: &Arc<Device>, name: &str, size: u64, location: MemoryLocation) -> Result<Self, VkError> {
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         Self::new(device, name, size, usage, location)
@@ -89,6 +89,15 @@ impl Buffer {
     /// The (host-visible) buffer's memory, to write in place.
     pub fn bytes_mut(&mut self) -> &mut [u8] {
         self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).expect("buffer is not host visible")
+    }
+
+    /// Records filling the whole buffer with the 32-bit word `word` (a
+    /// transfer write: [`crate::vk::Access::TransferWrite`]). The buffer
+    /// needs `TRANSFER_DST` usage, as [`Buffer::storage`] gives it.
+    pub fn fill(&self, rec: Recording<'_>, word: u32) {
+        // SAFETY: the buffer is alive while the submission runs (the caller
+        // holds it across `Commands::run`, which waits).
+        unsafe { rec.device.cmd_fill_buffer(rec.cmd, self.raw, 0, vk::WHOLE_SIZE, word) };
     }
 
     /// Copies `bytes` into the (host-visible) buffer at `offset`.

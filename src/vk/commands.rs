@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::sync::{Access, Recording};
 use super::{Device, VkError};
 
 /// One reusable command buffer with its pool and fence.
@@ -45,13 +46,23 @@ impl Commands {
     }
 
     /// Records commands with `record`, submits them and waits until done.
-    pub fn run<R>(&mut self, record: impl FnOnce(&ash::Device, vk::CommandBuffer) -> R) -> Result<R, VkError> {
+    /// The submission ends with a barrier that makes its writes visible to
+    /// the host (which reads mapped buffers once the fence is signalled);
+    /// dependencies between submissions are the passes' own barriers.
+    pub fn run<R>(&mut self, record: impl FnOnce(Recording<'_>) -> R) -> Result<R, VkError> {
         let raw = &self.device.raw;
+        let rec = Recording { device: raw, cmd: self.cmd };
+        let mut written = vec![Access::TransferWrite, Access::AccelerationStructureBuild];
+        written.extend(self.device.shader_stages().iter().map(|&s| Access::ShaderWrite(s)));
+        // SAFETY: the command buffer belongs to this pool, which only this
+        // thread uses (`&mut self`); the fence wait below ends its use by
+        // the device before it is reset again.
         unsafe {
             raw.reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())?;
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             raw.begin_command_buffer(self.cmd, &begin)?;
-            let out = record(raw, self.cmd);
+            let out = record(rec);
+            rec.barrier(&written, &[Access::HostRead]);
             raw.end_command_buffer(self.cmd)?;
             let cmds = [self.cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
@@ -60,23 +71,6 @@ impl Commands {
             raw.wait_for_fences(&[self.fence], true, u64::MAX)?;
             Ok(out)
         }
-    }
-}
-
-/// A full memory barrier between compute/transfer/acceleration-structure work.
-pub fn full_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
-    let access = vk::AccessFlags::SHADER_READ
-        | vk::AccessFlags::SHADER_WRITE
-        | vk::AccessFlags::TRANSFER_READ
-        | vk::AccessFlags::TRANSFER_WRITE
-        | vk::AccessFlags::ACCELERATION_STRUCTURE_READ_KHR
-        | vk::AccessFlags::ACCELERATION_STRUCTURE_WRITE_KHR;
-    let barrier = vk::MemoryBarrier::default().src_access_mask(access).dst_access_mask(access);
-    let stages = vk::PipelineStageFlags::COMPUTE_SHADER
-        | vk::PipelineStageFlags::TRANSFER
-        | vk::PipelineStageFlags::ACCELERATION_STRUCTURE_BUILD_KHR;
-    unsafe {
-        device.cmd_pipeline_barrier(cmd, stages, stages, vk::DependencyFlags::empty(), &[barrier], &[], &[]);
     }
 }
 

@@ -246,11 +246,36 @@ impl Device {
         }))
     }
 
+    /// The backend for a pass that asks for `requested`: that one if the
+    /// device was created with it (an error if not: a backend asked for is
+    /// never silently replaced), the device's preferred one when `None`
+    /// (ray queries where offered, else the pipeline).
+    pub fn backend_for(&self, requested: Option<super::Backend>) -> Result<super::Backend, VkError> {
+        use super::Backend;
+        match requested {
+            Some(b) if self.offers(b) => Ok(b),
+            Some(b) => Err(VkError::BackendUnavailable { device: self.name.clone(), backend: b }),
+            None if self.offers(Backend::RayQuery) => Ok(Backend::RayQuery),
+            None => Ok(Backend::Pipeline),
+        }
+    }
+
     /// Whether the device was created with what `backend` needs.
     pub fn offers(&self, backend: super::Backend) -> bool {
         match backend {
             super::Backend::RayQuery => self.ray_query,
             super::Backend::Pipeline => self.ray_tracing.is_some(),
+        }
+    }
+
+    /// The shader stages that passes on this device can run in: compute
+    /// always, the ray-tracing stages where the device was created with
+    /// ray-tracing pipelines (only then may a barrier name them).
+    pub fn shader_stages(&self) -> &'static [super::ShaderStage] {
+        if self.offers(super::Backend::Pipeline) {
+            &[super::ShaderStage::Compute, super::ShaderStage::RayTracing]
+        } else {
+            &[super::ShaderStage::Compute]
         }
     }
 

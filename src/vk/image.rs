@@ -6,7 +6,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
-use super::{Buffer, Device, VkError};
+use super::{Access, Buffer, Device, Recording, VkError};
 
 /// A 2D image (one mip level, one layer) with a view, freed on drop.
 pub struct Image {
@@ -187,34 +187,11 @@ impl Image {
         };
     }
 
-    /// Records a transition from `from` to `to`, making all earlier
-    /// compute and transfer writes visible to later compute and transfer work.
-    pub fn transition(&self, cmd: vk::CommandBuffer, from: vk::ImageLayout, to: vk::ImageLayout) {
-        let access = vk::AccessFlags::SHADER_READ
-            | vk::AccessFlags::SHADER_WRITE
-            | vk::AccessFlags::TRANSFER_READ
-            | vk::AccessFlags::TRANSFER_WRITE;
-        let barrier = vk::ImageMemoryBarrier::default()
-            .src_access_mask(access)
-            .dst_access_mask(access)
-            .old_layout(from)
-            .new_layout(to)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(self.raw)
-            .subresource_range(self.all_levels());
-        let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
-        unsafe {
-            self.device.raw.cmd_pipeline_barrier(
-                cmd,
-                stages,
-                stages,
-                vk::DependencyFlags::empty(),
-                &[],
-                &[],
-                &[barrier],
-            )
-        };
+    /// Records a barrier over every level of the image from the accesses
+    /// `prev` in layout `from` to the accesses `next` in layout `to` (a
+    /// layout transition where they differ).
+    pub fn transition(&self, rec: Recording<'_>, from: (&[Access], vk::ImageLayout), to: (&[Access], vk::ImageLayout)) {
+        rec.image_barrier(self.raw, self.all_levels(), from, to);
     }
 
     /// Records clearing the (GENERAL layout) image to zero.

@@ -18,6 +18,7 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 pub struct ValidationCounters {
     errors: AtomicUsize,
     warnings: AtomicUsize,
+    hazards: AtomicUsize,
 }
 
 impl ValidationCounters {
@@ -29,6 +30,12 @@ impl ValidationCounters {
     /// Messages of warning severity seen so far.
     pub fn warnings(&self) -> usize {
         self.warnings.load(Ordering::SeqCst)
+    }
+
+    /// Synchronisation hazards (`SYNC-HAZARD-*` messages, also counted as
+    /// errors) seen so far.
+    pub fn hazards(&self) -> usize {
+        self.hazards.load(Ordering::SeqCst)
     }
 }
 
@@ -44,7 +51,10 @@ pub struct Instance {
 
 impl Instance {
     /// Creates a Vulkan 1.2 instance; with `validation`, enables the Khronos
-    /// validation layer (failing if it is not installed) and a messenger.
+    /// validation layer (failing if it is not installed), its
+    /// synchronisation checks (`VK_EXT_validation_features`; they run in the
+    /// layer, so on lavapipe too, which would otherwise hide a missing
+    /// barrier by running commands one after another) and a messenger.
     pub fn new(validation: bool) -> Result<Self, VkError> {
         Self::with_extensions(validation, &[])
     }
@@ -68,7 +78,15 @@ impl Instance {
             }
             layers.push(VALIDATION_LAYER.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+            let layer_extensions = unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }?;
+            let features = ash::ext::validation_features::NAME;
+            if !layer_extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(features)) {
+                return Err(VkError::MissingValidationLayer);
+            }
+            extensions.push(features.as_ptr());
         }
+        let sync_checks = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync_checks);
 
         let counters = Arc::new(ValidationCounters::default());
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
@@ -91,7 +109,7 @@ impl Instance {
             .enabled_extension_names(&extensions);
         if validation {
             // Also report problems in vkCreateInstance / vkDestroyInstance.
-            info = info.push_next(&mut messenger_info);
+            info = info.push_next(&mut messenger_info).push_next(&mut validation_features);
         }
         let raw = match unsafe { entry.create_instance(&info, None) } {
             Ok(raw) => raw,
@@ -149,9 +167,17 @@ unsafe extern "system" fn debug_callback(
     };
     // `user` points into the instance's Arc, which outlives the messenger.
     let counters = (user as *const ValidationCounters).as_ref();
+    let id = if data.is_null() || (*data).p_message_id_name.is_null() {
+        std::borrow::Cow::Borrowed("")
+    } else {
+        CStr::from_ptr((*data).p_message_id_name).to_string_lossy()
+    };
     if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
         if let Some(c) = counters {
             c.errors.fetch_add(1, Ordering::SeqCst);
+            if id.starts_with("SYNC-HAZARD") {
+                c.hazards.fetch_add(1, Ordering::SeqCst);
+            }
         }
         log::error!(target: "vulkan", "[{kind:?}] {message}");
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {

@@ -18,6 +18,7 @@ mod sampler;
 mod surface;
 #[cfg(feature = "viewer")]
 mod swapchain;
+mod sync;
 mod timestamps;
 
 use std::sync::Arc;
@@ -26,7 +27,7 @@ pub use accel::{AccelerationStructure, Instance as AsInstance};
 pub use ash::vk;
 pub use buffer::Buffer;
 pub use capabilities::{preference, survey, Backend, Capabilities, PipelineLimits, Survey};
-pub use commands::{full_barrier, Commands};
+pub use commands::Commands;
 pub use device::{Device, RayTracing, SETUP_HINT};
 pub use gpu_allocator::MemoryLocation;
 pub use image::Image;
@@ -38,6 +39,7 @@ pub use sampler::Sampler;
 pub use surface::{surface_extensions, Surface};
 #[cfg(feature = "viewer")]
 pub use swapchain::{PresentResult, Swapchain};
+pub use sync::{Access, Dependency, Recording, ShaderStage};
 pub use timestamps::{GpuTimer, Timestamps};
 
 /// Errors from the Vulkan backend.
@@ -52,6 +54,14 @@ pub enum VkError {
     /// No device has what the renderer needs.
     #[error("no Vulkan device can trace rays (ray queries or ray-tracing pipelines); {0}")]
     NoSuitableDevice(String),
+    /// A pass asked for a backend the device was not created with.
+    #[error("{device} was not created with the {backend} backend (`quadray devices` lists what each device offers)")]
+    BackendUnavailable {
+        /// The device's name.
+        device: String,
+        /// The backend asked for.
+        backend: Backend,
+    },
     /// Memory allocation failed.
     #[error("GPU memory allocation failed: {0}")]
     Allocation(String),

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{full_barrier, Buffer, Commands, Device, MemoryLocation, Surface, VkError};
+use super::{Access, Buffer, Commands, Device, MemoryLocation, Surface, VkError};
 
 /// What [`Swapchain::present`] found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,9 +162,19 @@ impl Swapchain {
         }
         let image = self.images[index as usize];
         let (staging, extent) = (&self.staging, self.extent);
-        cmds.run(|d, cmd| {
-            full_barrier(d, cmd);
-            transition(d, cmd, image, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+        let copy = [Access::TransferWrite];
+        let whole =
+            vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1);
+        cmds.run(|rec| {
+            // Acquired through a fence that was waited on: nothing before
+            // the copy touches the image; the presentation engine reads it
+            // after the queue has finished (no access to name).
+            rec.image_barrier(
+                image,
+                whole,
+                (&[], vk::ImageLayout::UNDEFINED),
+                (&copy, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+            );
             let region = vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers {
                     aspect_mask: vk::ImageAspectFlags::COLOR,
@@ -173,10 +183,23 @@ impl Swapchain {
                     layer_count: 1,
                 })
                 .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 });
+            // SAFETY: the image is the swapchain's, acquired above; the
+            // staging buffer outlives the submission (run waits).
             unsafe {
-                d.cmd_copy_buffer_to_image(cmd, staging.raw, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &[region])
+                rec.device.cmd_copy_buffer_to_image(
+                    rec.cmd,
+                    staging.raw,
+                    image,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &[region],
+                )
             };
-            transition(d, cmd, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR);
+            rec.image_barrier(
+                image,
+                whole,
+                (&copy, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+                (&[], vk::ImageLayout::PRESENT_SRC_KHR),
+            );
         })?;
         // The copy has finished (Commands::run waited): no semaphore needed.
         let swapchains = [self.raw];
@@ -188,35 +211,6 @@ impl Swapchain {
             Err(e) => Err(e.into()),
         }
     }
-}
-
-fn transition(d: &ash::Device, cmd: vk::CommandBuffer, image: vk::Image, from: vk::ImageLayout, to: vk::ImageLayout) {
-    let barrier = vk::ImageMemoryBarrier::default()
-        .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-        .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::MEMORY_READ)
-        .old_layout(from)
-        .new_layout(to)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(vk::ImageSubresourceRange {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 1,
-        });
-    unsafe {
-        d.cmd_pipeline_barrier(
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-            vk::DependencyFlags::empty(),
-            &[],
-            &[],
-            &[barrier],
-        )
-    };
 }
 
 impl Drop for Swapchain {

@@ -79,17 +79,17 @@ impl GpuTimer {
     pub fn run<R>(
         &self,
         cmds: &mut super::Commands,
-        record: impl FnOnce(&ash::Device, vk::CommandBuffer) -> R,
+        record: impl FnOnce(super::Recording<'_>) -> R,
     ) -> Result<(R, f64), VkError> {
         let start = std::time::Instant::now();
-        let out = cmds.run(|d, cmd| {
+        let out = cmds.run(|rec| {
             if let Some(s) = &self.stamps {
-                s.reset(cmd);
-                s.write(cmd, 0);
+                s.reset(rec.cmd);
+                s.write(rec.cmd, 0);
             }
-            let out = record(d, cmd);
+            let out = record(rec);
             if let Some(s) = &self.stamps {
-                s.write(cmd, 1);
+                s.write(rec.cmd, 1);
             }
             out
         })?;

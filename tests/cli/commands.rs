@@ -701,8 +701,15 @@ fn without_ray_queries_every_pass_runs_through_the_pipeline() {
     let reference: Vec<&str> =
         ["render", scene, "-o", "rq.exr", "--backend", "ray-query"].into_iter().chain(size).collect();
     render_ok(&reference, dir.path(), &[]);
-    let read = |name: &str| quadray::output::read_render_exr(&dir.path().join(name)).unwrap().output;
-    let (a, b) = (read("rq.exr"), read("pipeline.exr"));
+    let file = |name: &str| quadray::output::read_render_exr(&dir.path().join(name)).unwrap();
+    let (rq, pipe) = (file("rq.exr"), file("pipeline.exr"));
+    // The images say which backend made them.
+    let backend = |f: &quadray::output::ExrFile| {
+        f.metadata.iter().find(|(k, _)| k == quadray::output::METADATA_BACKEND).map(|(_, v)| v.clone())
+    };
+    assert_eq!(backend(&rq).as_deref(), Some("ray-query"));
+    assert_eq!(backend(&pipe).as_deref(), Some("pipeline"));
+    let (a, b) = (rq.output, pipe.output);
     let flip = quadray::metrics::flip_mean(&a, &b, 0.0).unwrap();
     println!("lens_fog without ray queries against ray queries: FLIP {flip:.6}");
     assert!(flip <= 0.001, "FLIP {flip}");

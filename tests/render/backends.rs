@@ -6,6 +6,9 @@
 //! pipeline forms the object ray with its own built-ins and visits the
 //! candidate boxes in another order: tests/geometry/geometry_gpu.rs
 //! measures it), so the images agree to rounding, not always to the bit.
+//! Each output records the backend that ran, and the test asserts it: a
+//! device without one of them fails here instead of comparing a backend
+//! with itself.
 
 use quadray::metrics::{flip_mean, relative_mse};
 use quadray::passes::RenderVariant;
@@ -42,11 +45,16 @@ fn every_test_scene_renders_the_same_with_both_backends() {
         let mut scene = common::project_scene(&format!("tests/{name}"));
         let depth = scene.image.max_depth;
         common::set_image(&mut scene, (64, 48), 4, depth);
-        let rq = common::render_variant_validated(&scene, RenderVariant::default());
+        let rq = common::render_variant_validated(
+            &scene,
+            RenderVariant { backend: Some(Backend::RayQuery), ..Default::default() },
+        );
         let pipe = common::render_variant_validated(
             &scene,
-            RenderVariant { backend: Backend::Pipeline, ..Default::default() },
+            RenderVariant { backend: Some(Backend::Pipeline), ..Default::default() },
         );
+        // The outputs say which backend ran: two backends were compared.
+        assert_eq!((rq.backend, pipe.backend), (Some(Backend::RayQuery), Some(Backend::Pipeline)), "{name}");
         let max = rq
             .radiance
             .iter()

@@ -26,7 +26,7 @@ const BRUTE_FORCE: RenderVariant = RenderVariant {
     volume: false,
     record_path: false,
     lookup: LookupMode::Probes,
-    backend: quadray::vk::Backend::RayQuery,
+    backend: Some(quadray::vk::Backend::RayQuery),
 };
 
 fn upload(ctx: &Context, cmds: &mut Commands, scene: &Scene) -> GpuScene {

@@ -119,7 +119,7 @@ fn run_twins_with(cases: &[TwinCase], env: Option<TwinEnvironment<'_>>) -> Vec<T
         let mut cmds = Commands::new(device).unwrap();
         let count = cases.len() as u32;
         let push = TwinPush { count, env_width: w, env_height: h, env_scale: scale };
-        cmds.run(|_, cmd| pipeline.dispatch(cmd, bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1])).unwrap();
+        cmds.run(|rec| pipeline.dispatch(rec.cmd, bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1])).unwrap();
         let mut r: Vec<TwinResult> = output.read();
         r.truncate(cases.len());
         r

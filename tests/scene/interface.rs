@@ -12,15 +12,24 @@ use quadray::shader_interface::*;
 use quadray::vk::reflect::{check_layout, HostLayout, InterfaceError, ShaderInterface};
 use quadray::vk::BindingKind;
 
+/// Every compiled shader by name: the compute shaders by file stem
+/// (`render`), the ray-tracing pipeline's stages by file name
+/// (`render.rgen`, `intersect.rint`, `closest_hit.rchit`, `miss.rmiss`).
 fn interfaces() -> Vec<(&'static str, ShaderInterface)> {
     quadray::shaders::all()
         .into_iter()
+        .chain(quadray::shaders::pipeline_all())
         .map(|(name, spirv)| (name, ShaderInterface::reflect(&spirv).unwrap_or_else(|e| panic!("{name}: {e}"))))
         .collect()
 }
 
+/// A shader's file stem: `render` for `render.comp` and `render.rgen`.
+fn stem(shader: &str) -> &str {
+    shader.split('.').next().unwrap_or(shader)
+}
+
 fn applies(layout: &HostLayout, shader: &str) -> bool {
-    layout.shaders.is_empty() || layout.shaders.contains(&shader)
+    layout.shaders.is_empty() || layout.shaders.contains(&stem(shader))
 }
 
 /// Structs of the shaders that have no twin in `passes::gpu`, and why.
@@ -38,7 +47,7 @@ fn host_structs_match_the_shaders_member_by_member() {
         let mut checked = Vec::new();
         for (name, iface) in &shaders {
             if let Some(s) = iface.structs.get(layout.glsl).filter(|_| applies(layout, name)) {
-                check_layout(layout, s).unwrap_or_else(|e| panic!("{name}.comp: {e}"));
+                check_layout(layout, s).unwrap_or_else(|e| panic!("{name}: {e}"));
                 checked.push(*name);
             }
         }
@@ -51,11 +60,8 @@ fn host_structs_match_the_shaders_member_by_member() {
             // the array's element (its stride is the element's size).
             let block = s.members.len() == 1 && s.members[0].size == 0;
             let twin = layouts.iter().any(|l| l.glsl == glsl && applies(l, name));
-            let exempt = NOT_IN_GPU_RS.iter().any(|(sh, g, _)| sh == name && g == glsl);
-            assert!(
-                block || twin || exempt,
-                "struct {glsl} of {name}.comp has no host twin in passes::gpu::host_layouts"
-            );
+            let exempt = NOT_IN_GPU_RS.iter().any(|(sh, g, _)| *sh == stem(name) && g == glsl);
+            assert!(block || twin || exempt, "struct {glsl} of {name} has no host twin in passes::gpu::host_layouts");
         }
     }
 }
@@ -73,12 +79,13 @@ fn bindings_and_constants_are_declared_by_name() {
         (BINDING_TEXTURES, "textures", BindingKind::SampledImages(MAX_TEXTURES)),
         (BINDING_RENDER_MAX_SAMPLE, "maxSample", BindingKind::StorageImage),
         (BINDING_RENDER_PATH, "path", BindingKind::StorageBuffer),
+        (BINDING_LOOP_BUDGET, "loopBudget", BindingKind::StorageBuffer),
     ];
     for (binding, name, kind) in expect {
         let b = &render.bindings[&binding];
         assert_eq!((b.name.as_str(), b.kind), (name, kind), "render binding {binding}");
     }
-    assert_eq!(render.bindings.len(), 18);
+    assert_eq!(render.bindings.len(), 19);
     assert_eq!(render.spec_constants[&SPEC_LOOKUP_MODE], "LOOKUP_MODE");
     assert_eq!(render.spec_constants[&SPEC_RECORD_PATH], "RECORD_PATH");
     assert_eq!(render.push_constant_size as usize, std::mem::size_of::<quadray::passes::gpu::RenderPush>());
@@ -95,10 +102,11 @@ fn bindings_and_constants_are_declared_by_name() {
         SPEC_RECORD_PATH,
         SPEC_LOOKUP_MODE,
         SPEC_PROBE_CURVATURE,
+        SPEC_LOOP_BUDGET,
     ];
     for (name, iface) in &shaders {
         for id in iface.spec_constants.keys() {
-            assert!(spec_ids.contains(id), "{name}.comp: constant_id {id} is not a SPEC_* of shader_interface.rs");
+            assert!(spec_ids.contains(id), "{name}: constant_id {id} is not a SPEC_* of shader_interface.rs");
         }
     }
     let texprobe = &shaders.iter().find(|(n, _)| *n == "texprobe").unwrap().1;
@@ -154,13 +162,53 @@ fn the_checks_fail_on_a_swapped_field_a_wrong_binding_and_an_unknown_constant() 
 
 #[test]
 fn every_shader_in_glsl_is_compiled_and_listed() {
-    let mut files: Vec<String> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl"))
-        .unwrap()
-        .flatten()
-        .filter_map(|e| e.file_name().to_str()?.strip_suffix(".comp").map(str::to_string))
-        .collect();
-    files.sort();
-    let mut listed: Vec<String> = quadray::shaders::all().into_iter().map(|(n, _)| n.to_string()).collect();
+    let names = |suffixes: &[&str]| -> Vec<String> {
+        let mut files: Vec<String> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl"))
+            .unwrap()
+            .flatten()
+            .filter_map(|e| e.file_name().to_str().map(str::to_string))
+            .filter(|n| suffixes.iter().any(|s| n.ends_with(s)))
+            .collect();
+        files.sort();
+        files
+    };
+    let mut listed: Vec<String> = quadray::shaders::all().into_iter().map(|(n, _)| format!("{n}.comp")).collect();
     listed.sort();
-    assert_eq!(files, listed);
+    assert_eq!(names(&[".comp"]), listed);
+    let mut stages: Vec<String> = quadray::shaders::pipeline_all().into_iter().map(|(n, _)| n.to_string()).collect();
+    stages.sort();
+    assert_eq!(names(&[".rgen", ".rint", ".rchit", ".rmiss"]), stages);
+}
+
+/// The stages every ray-tracing pipeline shares (`Tracer::new`).
+const SHARED_STAGES: [&str; 3] = ["intersect.rint", "closest_hit.rchit", "miss.rmiss"];
+
+/// Each pass's ray-tracing pipeline (its ray-generation shader with the
+/// shared intersection, closest-hit and miss stages, merged as
+/// `PipelineResources` merges them) declares exactly the bindings of its
+/// compute twin, by number, name and kind: the host binds one list to
+/// either backend. Push constants and specialisation constants agree too.
+#[test]
+fn every_pipeline_declares_the_interface_of_its_compute_twin() {
+    let shaders = interfaces();
+    let find = |name: &str| &shaders.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("{name}")).1;
+    let shared = SHARED_STAGES.iter().fold(ShaderInterface::default(), |m, s| m.merge(find(s).clone()).unwrap());
+    // The shared stages take the scene's geometry and nothing per pass.
+    for (binding, b) in &shared.bindings {
+        assert!(*binding <= BINDING_CELL_LISTS, "a shared stage declares pass binding {binding} ({})", b.name);
+    }
+    let mut checked = 0;
+    for (name, rgen) in shaders.iter().filter(|(n, _)| n.ends_with(".rgen")) {
+        let pipeline = rgen.clone().merge(shared.clone()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let twin = find(stem(name));
+        assert_eq!(pipeline.bindings, twin.bindings, "{name} and {}.comp declare other bindings", stem(name));
+        assert_eq!(pipeline.push_constant_size, twin.push_constant_size, "{name}: push constants");
+        let ids = |i: &ShaderInterface| i.spec_constants.keys().copied().collect::<Vec<_>>();
+        assert_eq!(ids(&pipeline), ids(twin), "{name}: specialisation constants");
+        let host: Vec<(u32, BindingKind)> = twin.bindings.iter().map(|(&n, b)| (n, b.kind)).collect();
+        assert_eq!(pipeline.check_bindings(&host), Ok(vec![]), "{name}");
+        eprintln!("{name} + shared stages = {}.comp: {} bindings", stem(name), pipeline.bindings.len());
+        checked += 1;
+    }
+    assert_eq!(checked, 5, "render, gbuffer, caustic_trace, volume and probe have pipelines");
 }
