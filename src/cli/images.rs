@@ -92,5 +92,17 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
         lum(&reference.radiance[worst]),
         lum(&test.radiance[worst])
     );
+    // Bit for bit: a refactor that must not change an image is checked here.
+    let differing = reference
+        .radiance
+        .iter()
+        .flatten()
+        .zip(test.radiance.iter().flatten())
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    match differing {
+        0 => println!("identical: every radiance value is the same to the bit"),
+        n => println!("{n} of {} radiance values differ in their bits", 3 * reference.radiance.len()),
+    }
     Ok(())
 }

@@ -21,7 +21,8 @@ const RAYS_PER_DISPATCH: u32 = 1 << 16;
 /// A ray-tracing pass over a fixed ray list.
 pub struct ProbePass {
     tracer: Tracer,
-    rays: Buffer,
+    // Bound to the tracer: kept alive with it.
+    _rays: Buffer,
     hits: Buffer,
     count: u32,
     timestamps: Timestamps,
@@ -69,7 +70,7 @@ impl ProbePass {
             .extend([(BINDING_PROBE_RAYS, Binding::Buffer(&rays_buf)), (BINDING_PROBE_HITS, Binding::Buffer(&hits))]);
         tracer.bind(&bindings)?;
         let timestamps = Timestamps::new(device, 2)?;
-        Ok(Self { tracer, rays: rays_buf, hits, count: rays.len() as u32, timestamps })
+        Ok(Self { tracer, _rays: rays_buf, hits, count: rays.len() as u32, timestamps })
     }
 
     /// Traces every ray; returns the hits and the GPU time in nanoseconds.
@@ -89,7 +90,6 @@ impl ProbePass {
     /// Records the pass into `rec` (timestamps around the dispatches),
     /// with no barrier: the caller orders it after what came before.
     pub fn record(&self, rec: Recording<'_>) {
-        let _ = &self.rays;
         self.timestamps.reset(rec.cmd);
         self.timestamps.write(rec.cmd, 0);
         let mut first = 0;

@@ -413,6 +413,15 @@ impl Renderer {
         Ok(())
     }
 
+    /// What a sample's dispatch waits for, and its own access: what earlier
+    /// submissions wrote must be visible to it (the clear or a restored
+    /// accumulation, the caustic and volume passes in compute shaders or
+    /// the tracing stage, the last sample).
+    fn sample_dependency(&self) -> ([Access; 3], [Access; 1]) {
+        let sample = Access::ShaderWrite(self.pipeline.stage());
+        ([Access::TransferWrite, Access::ShaderWrite(ShaderStage::Compute), sample], [sample])
+    }
+
     /// Samples per pixel accumulated since the last reset.
     pub fn samples(&self) -> u32 {
         self.samples
@@ -470,12 +479,9 @@ impl Renderer {
                 write_aov: (self.samples == 0) as u32,
             };
             let pipeline = &self.pipeline;
-            let sample = [Access::ShaderWrite(pipeline.stage())];
+            let (before, sample) = self.sample_dependency();
             let ((), seconds) = self.timer.run(cmds, |rec| {
-                // What earlier submissions wrote must be visible: the clear
-                // (or a restored accumulation), the caustic and volume
-                // passes (compute or the tracing stage), the last sample.
-                rec.barrier(&[Access::TransferWrite, Access::ShaderWrite(ShaderStage::Compute), sample[0]], &sample);
+                rec.barrier(&before, &sample);
                 pipeline.run(rec.cmd, bytemuck::bytes_of(&push), [t[2], t[3]], [RENDER_GROUP, RENDER_GROUP])
             })?;
             self.render_seconds += seconds;
@@ -662,9 +668,9 @@ impl Renderer {
         self.path.write(0, &[0u8; 4]);
         let push = RenderPush { tile_origin: [x, y], tile_size: [1, 1], sample_index: sample, write_aov: 0 };
         let pipeline = &self.pipeline;
-        let sample = [Access::ShaderWrite(pipeline.stage())];
+        let (before, sample) = self.sample_dependency();
         cmds.run(|rec| {
-            rec.barrier(&[Access::TransferWrite, Access::ShaderWrite(ShaderStage::Compute), sample[0]], &sample);
+            rec.barrier(&before, &sample);
             pipeline.run(rec.cmd, bytemuck::bytes_of(&push), [1, 1], [1, 1]);
         })?;
         let bytes: Vec<u8> = self.path.read();

@@ -136,20 +136,36 @@ fn mutated_scenes_parse_or_fail_cleanly() {
     );
 }
 
+/// Every file of `tests/<folder>/`, read as (lossy) UTF-8 as the fuzz
+/// target reads its input.
+fn replay(folder: &str) -> Vec<(String, String)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join(folder);
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().is_some_and(|n| n != "README.md"))
+        .collect();
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| (p.display().to_string(), String::from_utf8_lossy(&std::fs::read(&p).unwrap()).into_owned()))
+        .collect()
+}
+
+/// The inputs the coverage-guided fuzzer once crashed on
+/// (`tests/fuzz_crashes/`, where `scripts/fuzz.sh` copies every new crash)
+/// and its minimised corpus (`tests/fuzz_corpus/`: the inputs that reached
+/// new coverage in its runs, `cargo fuzz cmin`) parse or fail with an error,
+/// never panic. The corpus is never empty: a run that lost it fails here.
 #[test]
-fn recorded_fuzzer_crashes_no_longer_crash() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_crashes");
-    let mut n = 0;
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "toml") {
-            let bytes = std::fs::read(&path).unwrap();
-            let text = String::from_utf8_lossy(&bytes);
-            if let Err(e) = parses_without_panic(&text, &path.display().to_string()) {
-                panic!("{}: {e}", path.display());
-            }
-            n += 1;
+fn recorded_fuzzer_inputs_no_longer_crash() {
+    let crashes = replay("fuzz_crashes");
+    let corpus = replay("fuzz_corpus");
+    assert!(!corpus.is_empty(), "tests/fuzz_corpus/ is empty: run scripts/fuzz.sh to regenerate it");
+    for (name, text) in crashes.iter().chain(&corpus) {
+        if let Err(e) = parses_without_panic(text, name) {
+            panic!("{name}: {e}");
         }
     }
-    println!("{n} recorded fuzzer crashes replayed without a panic");
+    println!("{} recorded fuzzer crashes and {} corpus inputs replayed without a panic", crashes.len(), corpus.len());
 }
