@@ -165,24 +165,12 @@ impl Recording<'_> {
     pub fn barrier(&self, prev: &[Access], next: &[Access]) {
         let d = Dependency::between(prev, next);
         let barrier = [vk::MemoryBarrier::default().src_access_mask(d.src_access).dst_access_mask(d.dst_access)];
-        // SAFETY: `cmd` is in the recording state (Commands::run began it)
-        // and the barrier's masks name stages of enabled features only: a
-        // ray-tracing access exists only where a pipeline-backend pass runs.
-        unsafe {
-            self.device.cmd_pipeline_barrier(
-                self.cmd,
-                d.src_stages,
-                d.dst_stages,
-                vk::DependencyFlags::empty(),
-                &barrier,
-                &[],
-                &[],
-            )
-        };
+        self.pipeline_barrier(&d, &barrier, &[]);
     }
 
     /// Records an image memory barrier (with a layout transition from
-    /// `from` to `to`) over every level of `image`.
+    /// `from` to `to`) over `range` of `image`, which the caller keeps
+    /// alive until the submission has finished.
     pub(super) fn image_barrier(
         &self,
         image: vk::Image,
@@ -203,16 +191,23 @@ impl Recording<'_> {
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(image)
             .subresource_range(range)];
-        // SAFETY: as in `barrier`; `image` is alive (the caller holds it).
+        self.pipeline_barrier(&d, &[], &barrier);
+    }
+
+    fn pipeline_barrier(&self, d: &Dependency, memory: &[vk::MemoryBarrier], images: &[vk::ImageMemoryBarrier]) {
+        // SAFETY: `cmd` is in the recording state (Commands::run began it);
+        // the masks name stages of enabled features only (a ray-tracing
+        // access exists only where a pipeline-backend pass runs); the
+        // images are alive (their owners outlive the submission).
         unsafe {
             self.device.cmd_pipeline_barrier(
                 self.cmd,
                 d.src_stages,
                 d.dst_stages,
                 vk::DependencyFlags::empty(),
+                memory,
                 &[],
-                &[],
-                &barrier,
+                images,
             )
         };
     }
