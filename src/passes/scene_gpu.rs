@@ -198,7 +198,7 @@ pub fn upload_texture(
         }
     }
     // Sampled by whichever shader stage a pass runs in.
-    let readers: Vec<Access> = device.shader_stages().iter().map(|&s| Access::ShaderRead(s)).collect();
+    let readers = device.in_every_stage(Access::ShaderRead);
     cmds.run(|rec| {
         image.copy_from_buffer(rec.cmd, &staging, &regions);
         image.transition(

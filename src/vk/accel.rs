@@ -91,7 +91,7 @@ impl AccelerationStructure {
         // visible; what reads the structure next is a build (a TLAS over
         // this BLAS) or a trace in any stage the device runs.
         let mut next = vec![Access::AccelerationStructureBuild];
-        next.extend(device.shader_stages().iter().map(|&s| Access::Trace(s)));
+        next.extend(device.in_every_stage(Access::Trace));
         cmds.run(|rec| {
             // SAFETY: the build's structures and scratch buffer live until
             // the submission has finished (run waits on its fence).

@@ -14,6 +14,9 @@ pub struct Commands {
     /// The command buffer.
     pub cmd: vk::CommandBuffer,
     fence: vk::Fence,
+    /// Every write a submission may make, made visible to the host at its
+    /// end (derived once: `run` is called once per dispatch).
+    written: Vec<Access>,
 }
 
 impl Commands {
@@ -42,7 +45,9 @@ impl Commands {
                 return Err(e.into());
             }
         };
-        Ok(Self { device: device.clone(), pool, cmd, fence })
+        let mut written = vec![Access::TransferWrite, Access::AccelerationStructureBuild];
+        written.extend(device.in_every_stage(Access::ShaderWrite));
+        Ok(Self { device: device.clone(), pool, cmd, fence, written })
     }
 
     /// Records commands with `record`, submits them and waits until done.
@@ -52,8 +57,6 @@ impl Commands {
     pub fn run<R>(&mut self, record: impl FnOnce(Recording<'_>) -> R) -> Result<R, VkError> {
         let raw = &self.device.raw;
         let rec = Recording { device: raw, cmd: self.cmd };
-        let mut written = vec![Access::TransferWrite, Access::AccelerationStructureBuild];
-        written.extend(self.device.shader_stages().iter().map(|&s| Access::ShaderWrite(s)));
         // SAFETY: the command buffer belongs to this pool, which only this
         // thread uses (`&mut self`); the fence wait below ends its use by
         // the device before it is reset again.
@@ -62,7 +65,7 @@ impl Commands {
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             raw.begin_command_buffer(self.cmd, &begin)?;
             let out = record(rec);
-            rec.barrier(&written, &[Access::HostRead]);
+            rec.barrier(&self.written, &[Access::HostRead]);
             raw.end_command_buffer(self.cmd)?;
             let cmds = [self.cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];

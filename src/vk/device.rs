@@ -279,6 +279,13 @@ impl Device {
         }
     }
 
+    /// `access` in every shader stage this device runs passes in (see
+    /// [`Device::shader_stages`]): what a barrier names for a resource any
+    /// pass may touch.
+    pub fn in_every_stage(&self, access: fn(super::ShaderStage) -> super::Access) -> Vec<super::Access> {
+        self.shader_stages().iter().map(|&s| access(s)).collect()
+    }
+
     /// Nanoseconds per timestamp tick.
     pub fn timestamp_period_ns(&self) -> f64 {
         self.properties.limits.timestamp_period as f64
