@@ -166,6 +166,9 @@ pub(crate) enum BackendChoice {
     /// A ray-tracing pipeline with the intersection shader
     /// (VK_KHR_ray_tracing_pipeline) for every tracing pass.
     Pipeline,
+    /// Compute shaders that walk the renderer's own BVH over the cells (no
+    /// ray-tracing extension).
+    Compute,
 }
 
 impl BackendChoice {
@@ -188,6 +191,7 @@ impl BackendChoice {
                  each device offers",
                 device.name
             ),
+            BackendChoice::Compute => Ok(Backend::Compute),
         }
     }
 }

@@ -2,6 +2,7 @@
 //! passes (rays, texture lookups) used by tests and benchmarks.
 
 pub mod bounds;
+pub mod bvh;
 pub mod caustics;
 pub mod checkpoint;
 pub mod gpu;
@@ -21,6 +22,6 @@ pub use probe::ProbePass;
 pub use render::{render, RecordedPath, RenderOutput, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene, LoopBudget, LOOP_LIMIT};
 pub use texprobe::TexProbePass;
-pub use tracer::Tracer;
+pub use tracer::{Tracer, TracerShaders};
 pub use variant::{IntersectMode, LookupMode, RenderVariant, ShadingMode};
 pub use volume::VolumeLight;

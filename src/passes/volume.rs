@@ -9,11 +9,11 @@ use std::sync::Arc;
 
 use super::gpu::VolumePush;
 use super::scene_gpu::GpuScene;
-use super::tracer::Tracer;
+use super::tracer::{Tracer, TracerShaders};
 use super::IntersectMode;
 use crate::shader_interface::{BINDING_VOLUME, RENDER_GROUP, SPEC_INTERSECT_MODE};
 use crate::vk::{Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, MemoryLocation};
-use crate::{shaders, RenderError};
+use crate::RenderError;
 
 /// Camera rays per pixel in one dispatch of the volume pass.
 pub const BATCH: u32 = 16;
@@ -46,8 +46,7 @@ impl VolumeLight {
         let pipeline = Tracer::new(
             device,
             backend,
-            shaders::volume,
-            shaders::volume_rgen,
+            TracerShaders::VOLUME,
             &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant()), gpu.loop_budget_constant()],
         )?;
         let mut bindings = gpu.frame_bindings(frame);

@@ -26,7 +26,7 @@ pub enum ShaderStage {
 impl From<Backend> for ShaderStage {
     fn from(backend: Backend) -> Self {
         match backend {
-            Backend::RayQuery => ShaderStage::Compute,
+            Backend::RayQuery | Backend::Compute => ShaderStage::Compute,
             Backend::Pipeline => ShaderStage::RayTracing,
         }
     }
