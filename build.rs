@@ -3,10 +3,6 @@
 //! the pipeline backend, built with RAY_TRACING_PIPELINE defined) to SPIR-V
 //! 1.4 for Vulkan 1.2 with shaderc (glslang), with the constants of
 //! `src/shader_interface.rs` as #defines.
-//! Every compute pass that has a ray-generation twin (it traces the scene)
-//! is compiled once more with COMPUTE_TRAVERSAL defined, to `NAME.bvh.comp`:
-//! the compute backend, which walks the project's BVH and needs no
-//! ray-tracing extension.
 //! The SPIR-V lands in OUT_DIR and is embedded by `src/shaders.rs`.
 
 use std::path::Path;
@@ -47,19 +43,9 @@ fn main() {
         .filter(|p| p.extension().and_then(|e| e.to_str()).is_some_and(|e| shader_kind(e).is_some()))
         .collect();
     sources.sort();
-    // (source, output name, COMPUTE_TRAVERSAL)
-    let mut jobs: Vec<(std::path::PathBuf, String, bool)> = Vec::new();
-    for path in &sources {
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        jobs.push((path.clone(), name.clone(), false));
-        if let Some(stem) = name.strip_suffix(".comp") {
-            if Path::new("glsl").join(format!("{stem}.rgen")).exists() {
-                jobs.push((path.clone(), format!("{stem}.bvh.comp"), true));
-            }
-        }
-    }
     let mut failed = false;
-    for (path, name, compute_traversal) in jobs {
+    for path in sources {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let source = std::fs::read_to_string(&path).unwrap();
         let mut options = shaderc::CompileOptions::new().unwrap();
         options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
@@ -73,9 +59,6 @@ fn main() {
         let kind = shader_kind(extension).expect("filtered above");
         if kind != shaderc::ShaderKind::Compute {
             options.add_macro_definition("RAY_TRACING_PIPELINE", Some("1"));
-        }
-        if compute_traversal {
-            options.add_macro_definition("COMPUTE_TRAVERSAL", Some("1"));
         }
         options.set_include_callback(|requested, _, _, _| {
             let p = Path::new("glsl").join(requested);

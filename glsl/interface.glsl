@@ -6,14 +6,12 @@
 
 #extension GL_EXT_scalar_block_layout : require
 // Compute passes trace with ray queries; the ray-tracing-pipeline backend's
-// shaders (built with RAY_TRACING_PIPELINE defined) with traceRayEXT; the
-// compute backend's (built with COMPUTE_TRAVERSAL defined) walk the
-// project's BVH (traverse_compute.glsl) and need neither extension.
+// shaders (built with RAY_TRACING_PIPELINE defined) with traceRayEXT.
 // Passes that trace nothing (NO_TRACING defined) declare neither, nor the
 // acceleration structure, so that they run on a device with either.
 #if defined(RAY_TRACING_PIPELINE)
 #extension GL_EXT_ray_tracing : require
-#elif !defined(NO_TRACING) && !defined(COMPUTE_TRAVERSAL)
+#elif !defined(NO_TRACING)
 #extension GL_EXT_ray_query : require
 #endif
 #extension GL_EXT_control_flow_attributes : require
@@ -64,7 +62,7 @@ struct Cell {
     uint count;
 };
 
-#if !defined(NO_TRACING) && !defined(COMPUTE_TRAVERSAL)
+#ifndef NO_TRACING
 layout(set = 0, binding = BINDING_TLAS) uniform accelerationStructureEXT tlas;
 #endif
 layout(set = 0, binding = BINDING_OBJECTS, scalar) readonly buffer Objects { Object objects[]; };

@@ -23,10 +23,8 @@ layout(constant_id = SPEC_INTERSECT_MODE) const uint INTERSECT_MODE = INTERSECT_
 #include "root_search.glsl"
 #include "derivatives.glsl"
 #include "hit.glsl"
-#if defined(RAY_TRACING_PIPELINE)
+#ifdef RAY_TRACING_PIPELINE
 #include "traverse_pipeline.glsl"
-#elif defined(COMPUTE_TRAVERSAL)
-#include "traverse_compute.glsl"
 #else
 #include "traverse.glsl"
 #endif

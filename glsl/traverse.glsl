@@ -6,7 +6,6 @@
 
 #include "root_search.glsl"
 #include "hit.glsl"
-#include "candidate.glsl"
 
 // The object (instance custom index) and its cell (index into cells[]) of
 // the candidate or committed intersection; `committed` must be a literal.
@@ -15,8 +14,9 @@
     (objects[object].firstCell + uint(rayQueryGetIntersectionPrimitiveIndexEXT(rq, committed)))
 
 // Runs the candidate loop: for each AABB, the first root in the cell
-// (closerRoot, candidate.glsl). Returns the object-space point of the
-// closest root found.
+// (candidateFirstRoot). The closest root of far rays is kept in f64 too,
+// so that roots closer together than one f32 step of t keep their order.
+// Returns the object-space point of the closest root found.
 vec3 proceedFunctional(rayQueryEXT rq, float tmin, float tmax) {
     float best = tmax;
     double best64 = double(tmax);
@@ -24,10 +24,33 @@ vec3 proceedFunctional(rayQueryEXT rq, float tmin, float tmax) {
     while (rayQueryProceedEXT(rq)) { LOOP_EDGE();
         if (rayQueryGetIntersectionTypeEXT(rq, false) != gl_RayQueryCandidateIntersectionAABBEXT) continue;
         uint object = candidateObject(rq, false);
-        if (closerRoot(object, candidateCell(rq, object, false), rayQueryGetIntersectionObjectRayOriginEXT(rq, false),
-                       rayQueryGetIntersectionObjectRayDirectionEXT(rq, false), rayQueryGetWorldRayOriginEXT(rq),
-                       rayQueryGetWorldRayDirectionEXT(rq), tmin, best, best64, bestPoint))
-            rayQueryGenerateIntersectionEXT(rq, best);
+        vec3 point;
+        bool far;
+        double tref;
+        float s = candidateFirstRoot(object, candidateCell(rq, object, false),
+                                     rayQueryGetIntersectionObjectRayOriginEXT(rq, false),
+                                     rayQueryGetIntersectionObjectRayDirectionEXT(rq, false),
+                                     rayQueryGetWorldRayOriginEXT(rq), rayQueryGetWorldRayDirectionEXT(rq), tmin, best,
+                                     best64, far, tref, point);
+        if (s == NO_ROOT) continue;
+        if (!far) {
+            if (s <= best) {
+                best = s;
+                best64 = double(s);
+                bestPoint = point;
+                rayQueryGenerateIntersectionEXT(rq, s);
+            }
+        } else {
+            // The bounds, rounded to f32 in s, may admit a root a hair
+            // outside them.
+            double t = max(tref + double(s), double(tmin));
+            if (t <= best64) {
+                best64 = t;
+                best = float(t);
+                bestPoint = point;
+                rayQueryGenerateIntersectionEXT(rq, best);
+            }
+        }
     }
     return bestPoint;
 }

@@ -202,22 +202,3 @@ pub const LOBE_REFLECT: u32 = 0;
 pub const LOBE_TRANSMIT: u32 = 1;
 /// Recorded lobe: invalid sample (the path ends).
 pub const LOBE_INVALID: u32 = 2;
-/// Descriptor binding of the BVH's nodes (compute backend; every tracing pass).
-pub const BINDING_BVH_NODES: u32 = 31;
-/// Descriptor binding of the BVH's leaf primitives (compute backend; every
-/// tracing pass).
-pub const BINDING_BVH_PRIMITIVES: u32 = 32;
-/// Descriptor binding of the objects' f32 world-to-object maps (compute
-/// backend; every tracing pass).
-pub const BINDING_BVH_OBJECTS: u32 = 33;
-/// BVH child word: set for a leaf (the rest: count - 1 above the first
-/// primitive's index).
-pub const BVH_LEAF: u32 = 2147483648;
-/// BVH child word: where a leaf's count - 1 starts.
-pub const BVH_LEAF_SHIFT: u32 = 28;
-/// BVH child word: a leaf's first primitive (the bits below the count).
-pub const BVH_FIRST_MASK: u32 = 268435455;
-/// BVH child word of an empty slot.
-pub const BVH_EMPTY: u32 = 4294967295;
-/// Entries of the compute backend's traversal stack (glsl/traverse_compute.glsl).
-pub const BVH_STACK: u32 = 64;

@@ -87,35 +87,3 @@ pipeline_shaders! {
     /// `glsl/miss.rmiss`: a miss into the payload.
     miss_rmiss = "miss.rmiss",
 }
-
-/// The compute backend's passes, compiled from `glsl/NAME.comp` with
-/// COMPUTE_TRAVERSAL defined (they walk the project's BVH,
-/// glsl/traverse_compute.glsl).
-macro_rules! bvh_shaders {
-    ($($(#[doc = $doc:literal])* $name:ident = $file:literal,)*) => {
-        $(
-            $(#[doc = $doc])*
-            pub fn $name() -> Vec<u32> {
-                words(include_bytes!(concat!(env!("OUT_DIR"), "/", $file, ".spv")))
-            }
-        )*
-
-        /// Every compute-backend pass with its file name, for interface checks.
-        pub fn bvh_all() -> Vec<(&'static str, Vec<u32>)> {
-            vec![$(($file, $name())),*]
-        }
-    };
-}
-
-bvh_shaders! {
-    /// `glsl/render.comp` on the compute backend.
-    render_bvh = "render.bvh.comp",
-    /// `glsl/gbuffer.comp` on the compute backend.
-    gbuffer_bvh = "gbuffer.bvh.comp",
-    /// `glsl/caustic_trace.comp` on the compute backend.
-    caustic_trace_bvh = "caustic_trace.bvh.comp",
-    /// `glsl/volume.comp` on the compute backend.
-    volume_bvh = "volume.bvh.comp",
-    /// `glsl/probe.comp` on the compute backend.
-    probe_bvh = "probe.bvh.comp",
-}

@@ -166,9 +166,6 @@ pub(crate) enum BackendChoice {
     /// A ray-tracing pipeline with the intersection shader
     /// (VK_KHR_ray_tracing_pipeline) for every tracing pass.
     Pipeline,
-    /// Compute shaders that walk the renderer's own BVH over the cells (no
-    /// ray-tracing extension).
-    Compute,
 }
 
 impl BackendChoice {
@@ -191,7 +188,6 @@ impl BackendChoice {
                  each device offers",
                 device.name
             ),
-            BackendChoice::Compute => Ok(Backend::Compute),
         }
     }
 }

@@ -26,7 +26,7 @@ use glam::{DVec2, DVec3};
 
 use super::gpu::{CausticPush, GpuCausticRay, GpuEmitter, GpuReceiver};
 use super::scene_gpu::GpuScene;
-use super::tracer::{Tracer, TracerShaders};
+use super::tracer::Tracer;
 use super::IntersectMode;
 use crate::geometry::CellParams;
 use crate::scene::{Light, Scene};
@@ -257,11 +257,12 @@ impl CausticMap {
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
         let intersect = gpu.intersect_mode(IntersectMode::Full).constant();
         let traced = [(SPEC_INTERSECT_MODE, intersect), gpu.loop_budget_constant()];
-        let gbuffer = Tracer::new(device, backend, TracerShaders::GBUFFER, &traced)?;
+        let gbuffer = Tracer::new(device, backend, shaders::gbuffer, shaders::gbuffer_rgen, &traced)?;
         let trace = Tracer::new(
             device,
             backend,
-            TracerShaders::CAUSTIC_TRACE,
+            shaders::caustic_trace,
+            shaders::caustic_trace_rgen,
             &[
                 (SPEC_INTERSECT_MODE, intersect),
                 (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),

@@ -2,7 +2,6 @@
 //! passes (rays, texture lookups) used by tests and benchmarks.
 
 pub mod bounds;
-pub mod bvh;
 pub mod caustics;
 pub mod checkpoint;
 pub mod gpu;
@@ -22,6 +21,6 @@ pub use probe::ProbePass;
 pub use render::{render, RecordedPath, RenderOutput, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene, LoopBudget, LOOP_LIMIT};
 pub use texprobe::TexProbePass;
-pub use tracer::{Tracer, TracerShaders};
+pub use tracer::Tracer;
 pub use variant::{IntersectMode, LookupMode, RenderVariant, ShadingMode};
 pub use volume::VolumeLight;

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use super::gpu::{GpuHit, GpuRay, ProbePush};
 use super::scene_gpu::GpuScene;
-use super::tracer::{Tracer, TracerShaders};
+use super::tracer::Tracer;
 use super::IntersectMode;
 use crate::shader_interface::{
     BINDING_PROBE_HITS, BINDING_PROBE_RAYS, PROBE_GROUP, SPEC_INTERSECT_MODE, SPEC_PROBE_CURVATURE,
@@ -13,7 +13,7 @@ use crate::shader_interface::{
 use crate::vk::{
     vk, Access, Backend, Binding, Buffer, Commands, Device, MemoryLocation, Recording, ShaderStage, Timestamps,
 };
-use crate::RenderError;
+use crate::{shaders, RenderError};
 
 /// Rays per dispatch: short enough never to trip a driver watchdog.
 const RAYS_PER_DISPATCH: u32 = 1 << 16;
@@ -57,7 +57,7 @@ impl ProbePass {
             (SPEC_PROBE_CURVATURE, u32::from(curvature)),
             scene.loop_budget_constant(),
         ];
-        let tracer = Tracer::new(device, backend, TracerShaders::PROBE, &spec)?;
+        let tracer = Tracer::new(device, backend, shaders::probe, shaders::probe_rgen, &spec)?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::storage(
             device,

@@ -9,7 +9,7 @@ use super::caustics::{emitters, CausticMap, CausticReport};
 use super::checkpoint::Accumulation;
 use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathRecord, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
-use super::tracer::{Tracer, TracerShaders};
+use super::tracer::Tracer;
 use super::volume::VolumeLight;
 use super::{RenderVariant, ShadingMode};
 use crate::scene::Scene;
@@ -20,7 +20,7 @@ use crate::shader_interface::{
     SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
 };
 use crate::vk::{vk, Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation, ShaderStage};
-use crate::RenderError;
+use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
 const TILE: u32 = 256;
@@ -695,7 +695,8 @@ fn render_pipeline(
     Ok(Tracer::new(
         device,
         backend,
-        TracerShaders::RENDER,
+        shaders::render,
+        shaders::render_rgen,
         &[
             (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect).constant()),
             gpu.loop_budget_constant(),

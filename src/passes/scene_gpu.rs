@@ -6,16 +6,14 @@ use std::sync::Arc;
 
 use glam::{DAffine3, DMat3, DVec3};
 
-use super::bvh::{Bvh, BvhBox, GpuBvhPrimitive};
 use super::gpu::{GpuCell, GpuLight, GpuLoopBudget, GpuMaterial, GpuObject, GpuPerturbation};
 use super::IntersectMode;
 use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Light, Scene, TextureImage};
 use crate::shader_interface::{
-    BINDING_BVH_NODES, BINDING_BVH_OBJECTS, BINDING_BVH_PRIMITIVES, BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME,
-    BINDING_LIGHTS, BINDING_LOOP_BUDGET, BINDING_MATERIALS, BINDING_OBJECTS, BINDING_PERTURBATIONS, BINDING_TEXTURES,
-    BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE, SPEC_LOOP_BUDGET,
+    BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_LOOP_BUDGET, BINDING_MATERIALS,
+    BINDING_OBJECTS, BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE, SPEC_LOOP_BUDGET,
 };
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::texture::scene_maps;
@@ -35,10 +33,6 @@ pub struct GeometryStats {
     pub table_bytes: u64,
     /// Bytes of the acceleration structures (bottom and top levels).
     pub accel_bytes: u64,
-    /// Bytes of the compute backend's BVH (nodes and leaf primitives).
-    pub bvh_bytes: u64,
-    /// Inner-node levels of the compute backend's BVH.
-    pub bvh_depth: u32,
 }
 
 /// A scene uploaded to the GPU.
@@ -46,12 +40,6 @@ pub struct GpuScene {
     /// Top-level acceleration structure.
     pub tlas: AccelerationStructure,
     _blases: Vec<AccelerationStructure>,
-    /// The compute backend's BVH nodes (`bvh::GpuBvhNode`).
-    pub bvh_nodes: Buffer,
-    /// The compute backend's BVH leaf primitives (`bvh::GpuBvhPrimitive`).
-    pub bvh_primitives: Buffer,
-    /// Each object's world-to-object map in f32, row-major 3x4 (`BvhObject`).
-    pub bvh_objects: Buffer,
     /// Object table.
     pub objects: Buffer,
     /// Cell table.
@@ -287,20 +275,6 @@ fn frobenius(m: &DMat3) -> f64 {
     m.to_cols_array().iter().map(|v| v * v).sum::<f64>().sqrt()
 }
 
-/// The box in the GPU's world frame around an object-frame box `lo..hi`
-/// placed by `to_world`: its corners mapped in f64, rounded outward.
-fn world_box(to_world: &DAffine3, lo: [f32; 3], hi: [f32; 3], primitive: GpuBvhPrimitive) -> BvhBox {
-    let (lo, hi) = (DVec3::from(lo.map(f64::from)), DVec3::from(hi.map(f64::from)));
-    let mut world = Aabb::new(DVec3::INFINITY, DVec3::NEG_INFINITY);
-    for corner in 0..8 {
-        let p = DVec3::select(glam::BVec3::new(corner & 1 != 0, corner & 2 != 0, corner & 4 != 0), hi, lo);
-        let w = to_world.transform_point3(p);
-        world = Aabb::new(world.min.min(w), world.max.max(w));
-    }
-    let (lo, hi) = f32_box(&world);
-    BvhBox { lo, hi, primitive }
-}
-
 /// Row-major 3x4 matrix of an affine transform.
 fn row_major_3x4(m: &DAffine3) -> [f32; 12] {
     let c = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation];
@@ -362,8 +336,6 @@ impl GpuScene {
         let mut lists: Vec<u32> = Vec::new();
         let mut blases = Vec::new();
         let mut placements = Vec::new();
-        let mut world_boxes = Vec::new();
-        let mut object_maps: Vec<[f32; 12]> = Vec::new();
         let reach = scene_reach(scene, origin);
 
         for (index, object) in scene.objects.iter().enumerate() {
@@ -376,7 +348,6 @@ impl GpuScene {
             let first_cell = cells.len() as u32;
             let relative = DAffine3::from_translation(-origin) * object.transform;
             objects.push(GpuObject::new(object, first_cell, &relative));
-            object_maps.push(row_major_3x4(&relative.inverse()));
             if object_cells.is_empty() {
                 continue;
             }
@@ -390,8 +361,6 @@ impl GpuScene {
                 let (lo, hi) = f32_box(&c.bounds);
                 let (blo, bhi) = if grow > 0.0 { f32_box(&c.bounds.padded(grow)) } else { (lo, hi) };
                 aabbs.push([blo[0], blo[1], blo[2], bhi[0], bhi[1], bhi[2]]);
-                let primitive = GpuBvhPrimitive { object: index as u32, cell: cells.len() as u32 };
-                world_boxes.push(world_box(&relative, blo, bhi, primitive));
                 cells.push(GpuCell { lo, hi, first: lists.len() as u32, count: c.perturbations.len() as u32 });
                 lists.extend(c.perturbations.iter().map(|&i| first_perturbation + i));
             }
@@ -404,7 +373,6 @@ impl GpuScene {
             .map(|&(b, t, index)| AsInstance { blas: &blases[b], transform: row_major_3x4(&t), custom_index: index })
             .collect();
         let tlas = AccelerationStructure::top_level(device, cmds, &instances)?;
-        let bvh = Bvh::build(world_boxes);
 
         let moments = scene_maps::slope_moments(scene);
         let materials: Vec<GpuMaterial> = scene
@@ -451,8 +419,6 @@ impl GpuScene {
                 + std::mem::size_of_val(cells.as_slice())
                 + std::mem::size_of_val(lists.as_slice())) as u64,
             accel_bytes: blases.iter().map(|b| b.buffer.size).sum::<u64>() + tlas.buffer.size,
-            bvh_bytes: bvh.bytes(),
-            bvh_depth: bvh.depth,
         };
         Ok(Self {
             objects: storage(device, "objects", bytemuck::cast_slice(&objects))?,
@@ -468,9 +434,6 @@ impl GpuScene {
             environment,
             tlas,
             _blases: blases,
-            bvh_nodes: storage(device, "bvh nodes", bytemuck::cast_slice(&bvh.nodes))?,
-            bvh_primitives: storage(device, "bvh primitives", bytemuck::cast_slice(&bvh.primitives))?,
-            bvh_objects: storage(device, "bvh objects", bytemuck::cast_slice(&object_maps))?,
             stats,
             origin,
             loop_budget: loop_budget_buffer(device)?,
@@ -539,15 +502,11 @@ impl GpuScene {
     }
 
     /// The bindings `BINDING_TLAS..=BINDING_CELL_LISTS` shared by all
-    /// passes, the compute backend's BVH (each pass's shader takes the
-    /// acceleration structure or the BVH) and the loop-budget report.
-    pub fn geometry_bindings(&self) -> [(u32, Binding<'_>); 9] {
+    /// passes, and the loop-budget report.
+    pub fn geometry_bindings(&self) -> [(u32, Binding<'_>); 6] {
         [
             (BINDING_LOOP_BUDGET, Binding::Buffer(&self.loop_budget)),
             (BINDING_TLAS, Binding::AccelerationStructure(&self.tlas)),
-            (BINDING_BVH_NODES, Binding::Buffer(&self.bvh_nodes)),
-            (BINDING_BVH_PRIMITIVES, Binding::Buffer(&self.bvh_primitives)),
-            (BINDING_BVH_OBJECTS, Binding::Buffer(&self.bvh_objects)),
             (BINDING_OBJECTS, Binding::Buffer(&self.objects)),
             (BINDING_CELLS, Binding::Buffer(&self.cells)),
             (BINDING_PERTURBATIONS, Binding::Buffer(&self.perturbations)),

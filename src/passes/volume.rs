@@ -9,11 +9,11 @@ use std::sync::Arc;
 
 use super::gpu::VolumePush;
 use super::scene_gpu::GpuScene;
-use super::tracer::{Tracer, TracerShaders};
+use super::tracer::Tracer;
 use super::IntersectMode;
 use crate::shader_interface::{BINDING_VOLUME, RENDER_GROUP, SPEC_INTERSECT_MODE};
 use crate::vk::{Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, MemoryLocation};
-use crate::RenderError;
+use crate::{shaders, RenderError};
 
 /// Camera rays per pixel in one dispatch of the volume pass.
 pub const BATCH: u32 = 16;
@@ -46,7 +46,8 @@ impl VolumeLight {
         let pipeline = Tracer::new(
             device,
             backend,
-            TracerShaders::VOLUME,
+            shaders::volume,
+            shaders::volume_rgen,
             &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant()), gpu.loop_budget_constant()],
         )?;
         let mut bindings = gpu.frame_bindings(frame);

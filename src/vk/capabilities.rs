@@ -22,21 +22,17 @@ pub enum Backend {
     /// without RT cores). Every tracing pass (render, G-buffer, caustic
     /// rays, volume, probes) has a ray-generation shader for it.
     Pipeline,
-    /// Compute shaders that walk the project's own BVH over the cells
-    /// (`glsl/traverse_compute.glsl`): no ray-tracing extension.
-    Compute,
 }
 
 impl Backend {
     /// Every backend, in the order `auto` prefers them.
-    pub const ALL: [Backend; 3] = [Backend::RayQuery, Backend::Pipeline, Backend::Compute];
+    pub const ALL: [Backend; 2] = [Backend::RayQuery, Backend::Pipeline];
 
     /// The name used on the command line and in JSON.
     pub fn name(self) -> &'static str {
         match self {
             Backend::RayQuery => "ray-query",
             Backend::Pipeline => "pipeline",
-            Backend::Compute => "compute",
         }
     }
 }
@@ -54,7 +50,7 @@ impl FromStr for Backend {
         Backend::ALL
             .into_iter()
             .find(|b| b.name() == s)
-            .ok_or_else(|| format!("unknown backend `{s}`: expected `ray-query`, `pipeline` or `compute`"))
+            .ok_or_else(|| format!("unknown backend `{s}`: expected `ray-query` or `pipeline`"))
     }
 }
 
@@ -231,7 +227,6 @@ impl Capabilities {
         let tracing = match backend {
             Backend::RayQuery => (self.ray_query, "VK_KHR_ray_query with rayQuery"),
             Backend::Pipeline => (self.ray_tracing_pipeline, "VK_KHR_ray_tracing_pipeline with rayTracingPipeline"),
-            Backend::Compute => (true, ""),
         };
         let needs = [
             (self.vulkan_1_2, "Vulkan 1.2"),

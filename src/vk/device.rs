@@ -265,7 +265,6 @@ impl Device {
         match backend {
             super::Backend::RayQuery => self.ray_query,
             super::Backend::Pipeline => self.ray_tracing.is_some(),
-            super::Backend::Compute => true,
         }
     }
 

@@ -26,7 +26,7 @@ pub enum ShaderStage {
 impl From<Backend> for ShaderStage {
     fn from(backend: Backend) -> Self {
         match backend {
-            Backend::RayQuery | Backend::Compute => ShaderStage::Compute,
+            Backend::RayQuery => ShaderStage::Compute,
             Backend::Pipeline => ShaderStage::RayTracing,
         }
     }
