@@ -10,6 +10,7 @@
 
 #include "intersect.glsl"
 #include "random.glsl"
+#include "sobol.glsl"
 #include "lights.glsl"
 #include "uv.glsl"
 
@@ -353,13 +354,13 @@ void queueShadowRay(ShadowRay r, vec3 radiance) {
 // BSDF-sampled continuation (which every vertex has, the last one included:
 // see "the last vertex" in tracePath). Returns the light's contribution if
 // its shadow ray `sr` is unblocked.
-vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 d, vec3 p, vec3 ng, float offset, Medium med, inout uint rng,
+vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 d, vec3 p, vec3 ng, float offset, Medium med, inout PathSampler rng,
                out ShadowRay sr) {
     uint choices = lightChoices();
     if (choices == 0u) return vec3(0.0);
-    uint i = min(uint(rand(rng) * float(choices)), choices - 1u);
+    uint i = min(uint(sample1(rng) * float(choices)), choices - 1u);
     float select = 1.0 / float(choices);
-    LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
+    LightSample ls = sampleLightOrEnvironment(i, p, sample2(rng));
     if (!ls.valid) return vec3(0.0);
     vec3 wiLocal = transpose(frameW) * ls.wi;
     // The light must lie on the side of the geometric surface that the
@@ -391,8 +392,8 @@ vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 d, vec3 p, vec3 ng, floa
 // cosine, the shadow ray is attenuated by the medium's transmittance. Used
 // for the environment and directional lights; positional lights use the
 // equiangular estimate over the whole segment instead.
-vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, inout uint rng, out ShadowRay sr) {
-    LightSample ls = sampleLightOrEnvironment(i, p, rand2(rng));
+vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, inout PathSampler rng, out ShadowRay sr) {
+    LightSample ls = sampleLightOrEnvironment(i, p, sample2(rng));
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
     float tr = transmittance(med, ls.dist);
@@ -410,14 +411,14 @@ vec3 mediumNextEvent(Medium med, vec3 d, vec3 p, uint i, float select, inout uin
 // sampling, density σ_t T(t), then the phase function). Returns the
 // estimate before the segment's throughput (it includes σ_s and both
 // transmittances).
-vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float select, inout uint rng,
+vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float select, inout PathSampler rng,
                           out ShadowRay sr) {
     Equiangular e = equiangularSetup(o, d, tEnd, lightCentre(i));
-    float t = equiangularSample(e, rand(rng));
+    float t = equiangularSample(e, sample1(rng));
     float pt = equiangularPdf(e, t);
     if (!(t >= 0.0 && t < tEnd) || !(pt > 0.0)) return vec3(0.0);
     vec3 x = o + t * d;
-    LightSample ls = sampleLight(lights[i], x, rand2(rng));
+    LightSample ls = sampleLight(lights[i], x, sample2(rng));
     if (!ls.valid) return vec3(0.0);
     float phase = hgPdf(med.anisotropy, dot(d, ls.wi));
     sr = ShadowRay(x, ls.wi, ls.dist, i);
@@ -436,11 +437,11 @@ vec3 equiangularNextEvent(Medium med, vec3 o, vec3 d, float tEnd, uint i, float 
 // by that smaller probability would push the throughput above 1 when the
 // path leaves (a sample that gains energy). So the η-corrected throughput
 // never exceeds 1 (outliers.rs states the bound this gives).
-bool survives(inout vec3 throughput, float etaScale, uint bounce, inout uint rng) {
+bool survives(inout vec3 throughput, float etaScale, uint bounce, inout PathSampler rng) {
     if (bounce + 1u < RR_DEPTH) return true;
     float q = clamp(max(throughput.x, max(throughput.y, throughput.z)) * etaScale, 0.05, 1.0);
     if (q >= 1.0) return true;
-    if (rand(rng) > q) return false;
+    if (sample1(rng) > q) return false;
     throughput /= q;
     record(EVENT_ROULETTE, NO_HIT, NO_TEXTURE, 0u, 0.0, 0.0, 0.0, q, vec3(0.0), vec3(1.0 / q), throughput, vec3(0.0));
     return true;
@@ -464,7 +465,7 @@ struct MediumScatter {
 // more specular vertices of the kinds caustic_trace.comp follows. The path
 // therefore ignores a sphere light it finds after leaving that vertex
 // through such vertices only; every other path is estimated as usual.
-vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
+vec3 tracePath(vec3 o, vec3 d, uint pixel, inout PathSampler rng) {
     MediaStack media = emptyStack();
     // The footprint (ray cone or covariance, path_footprint.glsl) starts as
     // its share of the pixel filter (cameraJitter).
@@ -545,7 +546,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             // the environment and directional lights get next-event
             // estimation at the distance-sampled scattering point below.
             uint choices = lightChoices();
-            uint li = choices > 0u ? min(uint(rand(rng) * float(choices)), choices - 1u) : frame.lightCount;
+            uint li = choices > 0u ? min(uint(sample1(rng) * float(choices)), choices - 1u) : frame.lightCount;
             float select = 1.0 / float(max(choices, 1u));
             bool last = bounce + 1u == frame.maxDepth;
             bool positional = choices > 0u && positionalLight(li);
@@ -553,7 +554,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                 vec3 c = equiangularNextEvent(med, o, d, tl, li, select, rng, sr);
                 queueShadowRay(sr, throughput * c);
             }
-            float ts = -log(1.0 - rand(rng)) / med.density;
+            float ts = -log(1.0 - sample1(rng)) / med.density;
             if (ts < tl && emitterOnly) {
                 // Scattered before reaching an emitter: that light would
                 // take one bounce more than the path may have.
@@ -567,7 +568,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
                     vec3 c = mediumNextEvent(med, d, p, li, select, rng, sr);
                     queueShadowRay(sr, throughput * c);
                 }
-                vec3 wi = sampleHg(med.anisotropy, d, rand2(rng));
+                vec3 wi = sampleHg(med.anisotropy, d, sample2(rng));
                 lastPdf = hgPdf(med.anisotropy, dot(d, wi));
                 record(EVENT_MEDIUM, NO_HIT, NO_TEXTURE, LOBE_REFLECT, ts, 0.0, dot(d, wi), lastPdf, p, v3(med.albedo),
                        throughput, radiance);
@@ -679,7 +680,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout uint rng) {
             queueShadowRay(sr, throughput * c);
         }
 
-        BsdfSample bs = bsdfSample(mat, wo, vec3(rand2(rng), rand(rng)));
+        BsdfSample bs = bsdfSample(mat, wo, vec3(sample2(rng), sample1(rng)));
         if (!bs.valid) {
             record(EVENT_SURFACE, h.object, matIndex, LOBE_INVALID, h.t, wo.z, bs.wi.z, bs.pdf, p, bs.weight, throughput,
                    radiance);
@@ -746,7 +747,7 @@ void renderPixel(uvec2 local) {
     if (any(greaterThanEqual(local, pc.tileSize))) return;
     uvec2 pix = pc.tileOrigin + local;
     uint idx = pix.y * frame.width + pix.x;
-    uint rng = seedRandom(pix, pc.sampleIndex, frame.seed);
+    PathSampler rng = pathSampler(pix, pc.sampleIndex, frame.seed);
 
     if (pc.writeAov != 0u) {
         // AOVs from the ray through the pixel centre.

@@ -3,8 +3,10 @@
 // by the host, so that tests/sampling/sampling_gpu.rs can compare them with their f64
 // CPU twins (src/sampling/).
 #extension GL_EXT_scalar_block_layout : require
+#extension GL_EXT_control_flow_attributes : require
 
 #include "lights.glsl"
+#include "sobol.glsl"
 
 layout(set = 0, binding = BINDING_TWIN_ENV_TABLE, scalar) readonly buffer EnvTable { float envTable[]; };
 layout(set = 0, binding = BINDING_TWIN_ENV_TEXELS, scalar) readonly buffer EnvTexels { vec4 envTexels[]; };
@@ -24,6 +26,7 @@ layout(local_size_x = 64) in;
 const uint OP_BSDF = 0u;
 const uint OP_LIGHT = 1u;
 const uint OP_ENVIRONMENT = 2u;
+const uint OP_SOBOL = 3u;  // u: the pixel seed's bits, the sample index, the dimension
 
 struct TwinCase {
     uint op;
@@ -58,7 +61,14 @@ void main() {
     r.eval = f3(vec3(0.0));
     r.pdfOf = 0.0;
     r.dist = 0.0;
-    if (c.op == OP_BSDF) {
+    if (c.op == OP_SOBOL) {
+        PathSampler s = PathSampler(floatBitsToUint(c.u[0]), uint(c.u[1]), uint(c.u[2]));
+        vec2 p = sample2(s);
+        r.wi = float[3](p.x, p.y, float(s.dimension));
+        r.weight = f3(vec3(0.0));
+        r.pdf = 0.0;
+        r.valid = 1u;
+    } else if (c.op == OP_BSDF) {
         vec3 wo = v3(c.wo), wi = v3(c.wi);
         BsdfSample s = bsdfSample(c.mat, wo, v3(c.u));
         r.wi = f3(s.wi);

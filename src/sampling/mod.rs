@@ -30,6 +30,7 @@ pub mod fresnel;
 pub mod ggx;
 pub mod lights;
 pub mod phase;
+pub mod sobol;
 pub mod warp;
 
 pub use bsdf::{
