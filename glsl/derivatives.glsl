@@ -10,11 +10,12 @@ vec3 cellGradient(uint object, uint cellIndex, vec3 p) {
     vec3 g = quadricGradient(objects[object].base, p);
     for (uint i = 0; i < cell.count; ++i) { LOOP_EDGE();
         uint k = cellLists[cell.first + i];
-        vec3 h = p - v3(perturbations[k].centre);
+        vec3 h = p - perturbationCentre(k);
         float radius = perturbations[k].radius;
         if (radius >= 0.0 && dot(h, h) > radius * radius) continue;
-        float q = quadricAt(perturbations[k].q, h);
-        if (q > 0.0) g += 3.0 * perturbations[k].f * q * q * quadricGradient(perturbations[k].q, h);
+        Quadric pq = perturbationQuadric(k);
+        float q = quadricAt(pq, h);
+        if (q > 0.0) g += 3.0 * perturbations[k].f * q * q * quadricGradient(pq, h);
     }
     return g;
 }
@@ -30,10 +31,10 @@ mat3 cellHessian(uint object, uint cellIndex, vec3 p) {
     mat3 hess = quadricHessian(objects[object].base);
     for (uint i = 0; i < cell.count; ++i) { LOOP_EDGE();
         uint k = cellLists[cell.first + i];
-        vec3 h = p - v3(perturbations[k].centre);
+        vec3 h = p - perturbationCentre(k);
         float radius = perturbations[k].radius;
         if (radius >= 0.0 && dot(h, h) > radius * radius) continue;
-        Quadric pq = perturbations[k].q;
+        Quadric pq = perturbationQuadric(k);
         float q = quadricAt(pq, h);
         if (q > 0.0) {
             vec3 g = quadricGradient(pq, h);

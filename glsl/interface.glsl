@@ -45,13 +45,17 @@ struct Object {
     double worldToObject[12];
 };
 
-// A perturbation f · max(Q, 0)³. Q is stored relative to `centre`, the centre
-// of a sphere of `radius` that bounds its support {Q >= 0}; radius < 0 marks
-// an unbounded support (centre 0).
+// A perturbation f · max(Q, 0)³ (48 bytes). A bounded support {Q >= 0} (an
+// ellipsoid) is stored about its centre, where Q has no linear term:
+// Q(p) = hᵀAh + c with h = p - centre, inside a sphere of `radius` about
+// `centre`. An unbounded support (radius < 0) is stored in the object frame
+// with its linear part b in the same three floats: Q(p) = pᵀAp + b·p + c.
+// perturbationQuadric and perturbationCentre (quadric.glsl) read either.
 struct Perturbation {
-    Quadric q;
+    float a[6];
+    float c;
     float f;
-    float centre[3];
+    float centreOrLinear[3];
     float radius;
 };
 

@@ -81,11 +81,23 @@ bool positiveSomewhere(vec3 q, float lo, float hi) {
     return v > lo && v < hi && q.x + v * (q.y + v * q.z) > 0.0;
 }
 
+// Perturbation k's quadric about its centre (interface.glsl, Perturbation):
+// Q(p) = quadricAt(perturbationQuadric(k), p - perturbationCentre(k)).
+Quadric perturbationQuadric(uint k) {
+    bool bounded = perturbations[k].radius >= 0.0;
+    vec3 linear = bounded ? vec3(0.0) : v3(perturbations[k].centreOrLinear);
+    return Quadric(perturbations[k].a, float[3](linear.x, linear.y, linear.z), perturbations[k].c);
+}
+
+vec3 perturbationCentre(uint k) {
+    return perturbations[k].radius >= 0.0 ? v3(perturbations[k].centreOrLinear) : vec3(0.0);
+}
+
 // True when perturbation k is non-zero somewhere on p + s d, s in [lo, hi]:
 // first a cheap test against its bounding sphere, then its quadric, whose
 // restriction to the ray it returns in `q`.
 bool perturbationOnSegment(uint k, vec3 p, vec3 d, float lo, float hi, out vec3 q) {
-    vec3 h = p - v3(perturbations[k].centre);
+    vec3 h = p - perturbationCentre(k);
     float radius = perturbations[k].radius;
     q = vec3(0.0);
     if (radius >= 0.0) {
@@ -95,7 +107,7 @@ bool perturbationOnSegment(uint k, vec3 p, vec3 d, float lo, float hi, out vec3 
         float sq = sqrt(disc);
         if ((-b + sq) < lo * dd || (-b - sq) > hi * dd) return false;
     }
-    q = quadricAlongRay(perturbations[k].q, h, d);
+    q = quadricAlongRay(perturbationQuadric(k), h, d);
     return positiveSomewhere(q, lo, hi);
 }
 
@@ -111,7 +123,7 @@ vec3 shiftQuadratic(vec3 q, float m) {
 
 // Restriction of perturbation k to p + s d.
 vec3 perturbationAlongRay(uint k, vec3 p, vec3 d) {
-    return quadricAlongRay(perturbations[k].q, p - v3(perturbations[k].centre), d);
+    return quadricAlongRay(perturbationQuadric(k), p - perturbationCentre(k), d);
 }
 
 #endif

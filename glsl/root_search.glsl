@@ -27,7 +27,7 @@ double cellValue64(uint object, Cell cell, dvec3 p) {
     double v = quadricAt64(objects[object].base, p);
     [[dont_unroll]] for (uint i = 0; i < cell.count; ++i) { LOOP_EDGE();
         uint k = cellLists[cell.first + i];
-        double q = quadricAt64(perturbations[k].q, p - dvec3(v3(perturbations[k].centre)));
+        double q = quadricAt64(perturbationQuadric(k), p - dvec3(perturbationCentre(k)));
         if (q > 0.0) v += double(perturbations[k].f) * q * q * q;
     }
     return v;
@@ -288,6 +288,12 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
 // returned in f64 (docs/stability.md, "Far views").
 // ---------------------------------------------------------------------------
 
+// 0 when no ray of the scene starts beyond any object's rebaseDistance
+// (GpuScene::far_rays, decided on the host from how far the scene, its
+// lights and the camera's keyframes reach): the far-ray search and the
+// per-candidate load of rebaseDistance then compile out.
+layout(constant_id = SPEC_FAR_RAYS) const uint FAR_RAYS = 1u;
+
 // The ray in object `object`'s frame, in f64: its f64 world-to-object map
 // applied to the f32 world origin and direction.
 void objectRay64(uint object, vec3 worldOrigin, vec3 worldDir, out dvec3 o, out dvec3 d) {
@@ -308,8 +314,11 @@ void objectRay64(uint object, vec3 worldOrigin, vec3 worldDir, out dvec3 o, out 
 // it).
 float candidateFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, vec3 worldOrigin, vec3 worldDir, float tmin,
                          float tmax, double tmax64, out bool far, out double tref, out vec3 hitPoint) {
-    float rebase = objects[object].rebaseDistance;
-    far = dot(o, o) > rebase * rebase;
+    far = false;
+    if (FAR_RAYS != 0u) {
+        float rebase = objects[object].rebaseDistance;
+        far = dot(o, o) > rebase * rebase;
+    }
     dvec3 o64 = dvec3(0.0), d64 = dvec3(0.0);
     tref = 0.0;
     float lo = tmin, hi = tmax;

@@ -177,6 +177,11 @@ pub const BINDING_LOOP_BUDGET: u32 = 30;
 /// Specialisation constant id: 1 to measure the loop budget each tracing
 /// invocation leaves (glsl/loop_budget.glsl; off in renders).
 pub const SPEC_LOOP_BUDGET: u32 = 10;
+/// Specialisation constant id: 0 when no ray of the scene can start beyond
+/// an object's rebase distance (`GpuScene::far_rays`), which leaves the
+/// far-ray search (glsl/root_search.glsl, candidateFirstRoot) and its
+/// per-candidate test out of the shaders; 1 (the default) keeps them.
+pub const SPEC_FAR_RAYS: u32 = 11;
 /// Vertices a recorded path holds at most.
 pub const PATH_RECORD_VERTICES: u32 = 96;
 /// Recorded path event: a surface scattering (a BSDF sample).

@@ -256,7 +256,7 @@ impl CausticMap {
         let beams = Buffer::storage(device, "beam map", pixels * 24, MemoryLocation::GpuToCpu)?;
         let has_beams = scene.fog.is_some_and(|f| f.density > 0.0);
         let intersect = gpu.intersect_mode(IntersectMode::Full).constant();
-        let traced = [(SPEC_INTERSECT_MODE, intersect), gpu.loop_budget_constant()];
+        let traced = [[(SPEC_INTERSECT_MODE, intersect)].as_slice(), &gpu.scene_constants()].concat();
         let gbuffer = Tracer::new(device, backend, shaders::gbuffer, shaders::gbuffer_rgen, &traced)?;
         let trace = Tracer::new(
             device,
@@ -264,10 +264,10 @@ impl CausticMap {
             shaders::caustic_trace,
             shaders::caustic_trace_rgen,
             &[
-                (SPEC_INTERSECT_MODE, intersect),
-                (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),
-                gpu.loop_budget_constant(),
-            ],
+                [(SPEC_INTERSECT_MODE, intersect), (SPEC_MEDIA_ENABLED, u32::from(scene.has_media()))].as_slice(),
+                &traced[1..],
+            ]
+            .concat(),
         )?;
         let splat = ComputePipeline::new(device, &shaders::caustic_splat(), &[])?;
         let beam = ComputePipeline::new(device, &shaders::caustic_beams(), &[])?;

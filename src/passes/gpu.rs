@@ -105,28 +105,89 @@ impl GpuObject {
     }
 }
 
-/// `Perturbation` in interface.glsl.
+/// `Perturbation` in interface.glsl (48 bytes): a bounded support stored
+/// about its centre, where the quadric has no linear term; an unbounded one
+/// in the object frame, its linear term where the centre would be.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuPerturbation {
-    /// Perturbing quadric, relative to `centre`: Q(p) = q(p - centre).
-    pub q: GpuQuadric,
+    /// Axx, Ayy, Azz, Axy, Ayz, Axz of the perturbing quadric.
+    pub a: [f32; 6],
+    /// Its constant: Q(p) = hᵀAh + c about the centre (bounded), or
+    /// pᵀAp + b·p + c (unbounded).
+    pub c: f32,
     /// Form factor.
     pub f: f32,
-    /// Centre of a sphere bounding the support {Q >= 0} (object frame).
-    pub centre: [f32; 3],
+    /// Bounded support: the centre of the sphere bounding {Q >= 0} (object
+    /// frame). Unbounded: the linear part b.
+    pub centre_or_linear: [f32; 3],
     /// Radius of that sphere; negative when the support is unbounded.
     pub radius: f32,
 }
 
+/// A bounded support's quadric about its centre keeps a linear term of
+/// rounding size only (the centre solves ∇Q = 0 in f64), dropped on the GPU
+/// while it is below this share of the quadric's other terms over the
+/// support (f32 resolves 6e-8 of them). A support so ill-conditioned that
+/// its term is larger is stored as an unbounded one (exact, without the
+/// bounding-sphere test).
+const DROPPED_LINEAR_TERM: f64 = 1e-9;
+
 impl From<&Perturbation> for GpuPerturbation {
     fn from(p: &Perturbation) -> Self {
-        let (centre, radius) = match p.quadric.support_sphere() {
-            Some((c, r)) => (c, r as f32),
-            None => (DVec3::ZERO, -1.0),
+        let about_centre = p.quadric.support_sphere().and_then(|(centre, radius)| {
+            let local = p.quadric.transformed(&DAffine3::from_translation(-centre));
+            let quadratic = local.a.to_cols_array().iter().fold(0.0f64, |m, v| m.max(v.abs())) * radius * radius;
+            let negligible = local.b.length() * radius <= DROPPED_LINEAR_TERM * quadratic.max(local.c.abs());
+            negligible.then_some((centre, local, radius as f32))
+        });
+        let (centre_or_linear, q, radius) = match about_centre {
+            Some((centre, local, radius)) => (centre, GpuQuadric::from(&local), radius),
+            None => (p.quadric.b, GpuQuadric::from(&p.quadric), -1.0),
         };
-        let local = p.quadric.transformed(&DAffine3::from_translation(-centre));
-        Self { q: GpuQuadric::from(&local), f: p.form_factor as f32, centre: centre.as_vec3().to_array(), radius }
+        Self {
+            a: q.a,
+            c: q.c,
+            f: p.form_factor as f32,
+            centre_or_linear: centre_or_linear.as_vec3().to_array(),
+            radius,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bounded support goes up about its centre with no linear term, an
+    /// unbounded one with its linear term in place of the centre; both give
+    /// the quadric's values (f32).
+    #[test]
+    fn perturbations_keep_their_quadric_in_48_bytes() {
+        assert_eq!(std::mem::size_of::<GpuPerturbation>(), 48);
+        let ellipsoid = Quadric::ellipsoid(DVec3::new(0.3, -0.2, 0.9), DVec3::new(0.05, 0.08, 0.03));
+        let turned = ellipsoid.transformed(&DAffine3::from_rotation_y(0.7));
+        let plane = Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -2.0, 0.5, 0.25]);
+        for (q, bounded) in [(ellipsoid, true), (turned, true), (plane, false)] {
+            let g = GpuPerturbation::from(&Perturbation { quadric: q, form_factor: 0.5 });
+            assert_eq!(g.radius >= 0.0, bounded);
+            let centre = if bounded { DVec3::from(g.centre_or_linear.map(f64::from)) } else { DVec3::ZERO };
+            let b = if bounded { DVec3::ZERO } else { DVec3::from(g.centre_or_linear.map(f64::from)) };
+            let [xx, yy, zz, xy, yz, xz] = g.a.map(f64::from);
+            for p in [DVec3::new(0.3, -0.2, 0.9), DVec3::new(0.33, -0.15, 0.88), DVec3::new(-1.0, 0.5, 2.0)] {
+                let h = p - centre;
+                let gpu = xx * h.x * h.x
+                    + yy * h.y * h.y
+                    + zz * h.z * h.z
+                    + 2.0 * (xy * h.x * h.y + yz * h.y * h.z + xz * h.x * h.z)
+                    + b.dot(h)
+                    + f64::from(g.c);
+                let exact = q.eval(p);
+                // f32 coefficients: within a few roundings of the terms' size.
+                let size = q.a.abs().mul_vec3(h.abs()).dot(h.abs()) + b.abs().dot(h.abs()) + f64::from(g.c).abs();
+                assert!((gpu - exact).abs() <= 1e-6 * size, "{q:?} at {p}: {gpu} against {exact}");
+            }
+        }
     }
 }
 
@@ -621,7 +682,7 @@ pub fn host_layouts() -> Vec<HostLayout> {
         host_layout!(GpuObject as "Object" {
             base, material, first_cell, uv_mapping, u_axis, v_axis, uv_scale, uv_offset, rebase_distance, world_to_object
         }),
-        host_layout!(GpuPerturbation as "Perturbation" { q, f, centre, radius }),
+        host_layout!(GpuPerturbation as "Perturbation" { a, c, f, centre_or_linear, radius }),
         host_layout!(GpuCell as "Cell" { lo, hi, first, count }),
         host_layout!(GpuMaterial as "Material" {
             kind, albedo, emission, roughness, ior, fresnel, eta, k, albedo_map, normal_map, roughness_map,

@@ -52,11 +52,8 @@ impl ProbePass {
         curvature: bool,
         backend: Backend,
     ) -> Result<Self, RenderError> {
-        let spec = [
-            (SPEC_INTERSECT_MODE, mode.constant()),
-            (SPEC_PROBE_CURVATURE, u32::from(curvature)),
-            scene.loop_budget_constant(),
-        ];
+        let [budget, far] = scene.scene_constants();
+        let spec = [(SPEC_INTERSECT_MODE, mode.constant()), (SPEC_PROBE_CURVATURE, u32::from(curvature)), budget, far];
         let tracer = Tracer::new(device, backend, shaders::probe, shaders::probe_rgen, &spec)?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         let hits = Buffer::storage(

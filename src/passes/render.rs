@@ -692,6 +692,7 @@ fn render_pipeline(
     caustics: Option<&CausticMap>,
     volume: bool,
 ) -> Result<Tracer, RenderError> {
+    let [budget, far] = gpu.scene_constants();
     Ok(Tracer::new(
         device,
         backend,
@@ -699,7 +700,8 @@ fn render_pipeline(
         shaders::render_rgen,
         &[
             (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect).constant()),
-            gpu.loop_budget_constant(),
+            budget,
+            far,
             (SPEC_SHADING_MODE, variant.shading.constant()),
             (SPEC_FILTER_MODE, scene.image.filter.constant()),
             (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),

@@ -13,7 +13,8 @@ use crate::sampling::envmap::EnvironmentMap;
 use crate::scene::{Light, Scene, TextureImage};
 use crate::shader_interface::{
     BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_LOOP_BUDGET, BINDING_MATERIALS,
-    BINDING_OBJECTS, BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE, SPEC_LOOP_BUDGET,
+    BINDING_OBJECTS, BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE, SPEC_FAR_RAYS,
+    SPEC_LOOP_BUDGET,
 };
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::texture::scene_maps;
@@ -73,6 +74,9 @@ pub struct GpuScene {
     loop_budget: Buffer,
     /// Whether passes built from now on measure the loop budget.
     measure_loop_budget: bool,
+    /// Whether a ray can start beyond an object's rebase distance
+    /// ([`Self::far_rays`]).
+    far_rays: bool,
 }
 
 /// Loop back-edges Mesa 25.0's gallivm source allows one shader invocation
@@ -237,14 +241,19 @@ fn f32_box(b: &Aabb) -> ([f32; 3], [f32; 3]) {
 /// light's start on a plane 2 radii + 1 beyond the specular objects'
 /// bounding sphere, `caustics::parallel_grid`: within 3 reaches + 1).
 fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
+    // An animated camera's rays start at each keyframe's position.
+    let camera = scene.camera.keyframes.iter().map(|k| (k.position - origin).length()).fold(0.0, f64::max);
     let objects = scene
         .objects
         .iter()
         .filter_map(|o| {
+            // The farthest point of a box's image is one of its corners.
             let b = o.shape.bounds().ok()?;
-            let centre = o.transform.transform_point3(b.centre());
-            let radius = 0.5 * b.size().length() * frobenius(&o.transform.matrix3);
-            Some((centre - origin).length() + radius)
+            let corners = (0..8).map(|i| {
+                let pick = |axis: usize| if i >> axis & 1 == 0 { b.min[axis] } else { b.max[axis] };
+                (o.transform.transform_point3(DVec3::new(pick(0), pick(1), pick(2))) - origin).length()
+            });
+            Some(corners.fold(0.0, f64::max))
         })
         .fold(0.0, f64::max);
     let lights = scene.lights.iter().map(|l| match *l {
@@ -253,7 +262,30 @@ fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
         Light::Rect { corner, edge_u, edge_v, .. } => (corner - origin).length() + edge_u.length() + edge_v.length(),
         Light::Directional { .. } => 3.0 * objects + 1.0,
     });
-    lights.fold(objects, f64::max)
+    lights.fold(objects.max(camera), f64::max)
+}
+
+/// Whether a ray starting within `reach` of the GPU frame's origin can start
+/// beyond the object's rebase distance in its own frame (`to_world` maps
+/// the object's frame to the GPU's): the object-frame origin of a world
+/// point x is L⁻¹(x - t), at most ‖L⁻¹‖₂ (|x| + |t|) from the object's
+/// origin. 90 % of the rebase distance is the threshold, a margin over the
+/// f32 rounding of the hardware's object ray (a ray just beyond the rebase
+/// distance is as well served by the near search as one just within it:
+/// the distance is a choice, not a cliff).
+fn far_rays_possible(to_world: &DAffine3, rebase_distance: f64, reach: f64) -> bool {
+    stretch_bound(&to_world.matrix3.inverse()) * (reach + to_world.translation.length()) > 0.9 * rebase_distance
+}
+
+/// An upper bound on how far `m` stretches a vector (its spectral norm):
+/// the square root of the largest absolute row sum of mᵀm, which bounds
+/// that matrix's largest eigenvalue (Gershgorin). Exact for rotations and
+/// scalings; within 3^¼ of the norm otherwise (the Frobenius norm is within
+/// √3, too loose for [`far_rays_possible`]).
+fn stretch_bound(m: &DMat3) -> f64 {
+    let s = m.transpose() * *m;
+    let rows = (0..3).map(|i| (0..3).map(|j| s.col(j)[i].abs()).sum::<f64>());
+    rows.fold(0.0, f64::max).sqrt()
 }
 
 /// A bound, in object units, on the error of the object-frame ray the
@@ -337,6 +369,7 @@ impl GpuScene {
         let mut blases = Vec::new();
         let mut placements = Vec::new();
         let reach = scene_reach(scene, origin);
+        let mut far_rays = std::env::var_os("QUADRAY_FORCE_FAR").is_some();
 
         for (index, object) in scene.objects.iter().enumerate() {
             let object_cells = object
@@ -348,6 +381,7 @@ impl GpuScene {
             let first_cell = cells.len() as u32;
             let relative = DAffine3::from_translation(-origin) * object.transform;
             objects.push(GpuObject::new(object, first_cell, &relative));
+            far_rays |= far_rays_possible(&relative, GpuObject::rebase_distance(object), reach);
             if object_cells.is_empty() {
                 continue;
             }
@@ -438,7 +472,24 @@ impl GpuScene {
             origin,
             loop_budget: loop_budget_buffer(device)?,
             measure_loop_budget: false,
+            far_rays,
         })
+    }
+
+    /// Whether a ray of the scene can start beyond an object's rebase
+    /// distance (`GpuObject::rebase_distance`) and so needs the f64 far-ray
+    /// search (glsl/root_search.glsl): decided from how far from the frame's
+    /// origin the objects, lights and camera keyframes reach. When it
+    /// cannot, the passes' shaders are specialised without that search
+    /// (`SPEC_FAR_RAYS`), and near rays skip its per-candidate test.
+    pub fn far_rays(&self) -> bool {
+        self.far_rays
+    }
+
+    /// Keeps the far-ray search in the passes built from now on, whatever the
+    /// scene's reach: for a camera that may go anywhere (the viewer).
+    pub fn allow_far_rays(&mut self) {
+        self.far_rays = true;
     }
 
     /// Turns the loop-budget measurement on or off for the passes built
@@ -461,10 +512,11 @@ impl GpuScene {
         LoopBudget { most_edges: r.most_edges, invocations: r.invocations, spent: r.spent }
     }
 
-    /// The specialisation constant every tracing pass takes from the scene:
-    /// whether it measures the loop budget.
-    pub fn loop_budget_constant(&self) -> (u32, u32) {
-        (SPEC_LOOP_BUDGET, u32::from(self.measure_loop_budget))
+    /// The specialisation constants every tracing pass takes from the scene:
+    /// whether it measures the loop budget, and whether rays may come from
+    /// far away ([`Self::far_rays`]).
+    pub fn scene_constants(&self) -> [(u32, u32); 2] {
+        [(SPEC_LOOP_BUDGET, u32::from(self.measure_loop_budget)), (SPEC_FAR_RAYS, u32::from(self.far_rays))]
     }
 
     /// The texture array: every scene texture, the rest of the slots filled
@@ -524,4 +576,29 @@ pub fn camera_basis(scene: &Scene, width: u32, height: u32) -> [DVec3; 4] {
     let half = (0.5 * c.vfov_degrees.to_radians()).tan();
     let aspect = width as f64 / height as f64;
     [c.position, forward, right * half * aspect, up * half]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stretch bound is exact for rotations and scalings and never
+    /// below the stretch of any vector.
+    #[test]
+    fn stretch_bound_bounds_the_spectral_norm() {
+        let turn = DMat3::from_euler(glam::EulerRot::XYZ, 0.4, 1.0, -0.3);
+        assert!((stretch_bound(&turn) - 1.0).abs() < 1e-12);
+        assert!((stretch_bound(&DMat3::from_diagonal(DVec3::new(2.0, -3.0, 0.5))) - 3.0).abs() < 1e-12);
+        let m = turn
+            * DMat3::from_diagonal(DVec3::new(0.2, 5.0, 1.5))
+            * DMat3::from_euler(glam::EulerRot::ZYX, 1.1, -0.2, 0.7);
+        let bound = stretch_bound(&m);
+        let mut most = 0.0f64;
+        for i in 0..20_000 {
+            let (a, b) = (i as f64 * 2.399963, (1.0 - 2.0 * (i as f64 + 0.5) / 20_000.0).acos());
+            let v = DVec3::new(b.sin() * a.cos(), b.sin() * a.sin(), b.cos());
+            most = most.max((m * v).length());
+        }
+        assert!(most <= bound && bound <= 1.32 * most, "stretch {most}, bound {bound}");
+    }
 }

@@ -48,7 +48,11 @@ impl VolumeLight {
             backend,
             shaders::volume,
             shaders::volume_rgen,
-            &[(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant()), gpu.loop_budget_constant()],
+            &[
+                [(SPEC_INTERSECT_MODE, gpu.intersect_mode(IntersectMode::Full).constant())].as_slice(),
+                &gpu.scene_constants(),
+            ]
+            .concat(),
         )?;
         let mut bindings = gpu.frame_bindings(frame);
         bindings.push((BINDING_VOLUME, Binding::Buffer(&radiance)));

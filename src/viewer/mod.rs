@@ -198,7 +198,9 @@ impl App {
         let surface = Surface::new(&instance, display, handle)?;
         let device = Device::for_surface(instance, &surface)?;
         let mut cmds = Commands::new(&device)?;
-        let scene_gpu = GpuScene::for_render(&device, &mut cmds, &self.scene)?;
+        let mut scene_gpu = GpuScene::for_render(&device, &mut cmds, &self.scene)?;
+        // The camera may be flown anywhere.
+        scene_gpu.allow_far_rays();
         log::info!("viewer on {}", device.name);
         self.gpu = Some(WindowGpu { renderer: None, swapchain: None, cmds, scene_gpu, device, surface, window });
         self.dirty = Dirty { swapchain: true, renderer: true, camera: false };

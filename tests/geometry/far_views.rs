@@ -124,6 +124,7 @@ fn far_views_against_the_f64_reference() {
                 let scene = common::scene_with(vec![object]);
                 let gpu = GpuScene::with_origin(&ctx.device, &mut cmds, &scene, &CellParams::default(), camera)
                     .expect("the scene uploads");
+                assert!(gpu.far_rays(), "{} from {distance:e} radii: the far-ray search is left out", subject.name);
                 // A grid over the object's disc, seen from the camera.
                 let (e1, e2) = axis.any_orthonormal_pair();
                 let rays: Vec<GpuRay> = (0..GRID * GRID)
@@ -221,4 +222,23 @@ fn far_views_against_the_f64_reference() {
         "bounds: up to {EXACT_UP_TO:e} radii no lost, false or wrong hits; normals within 0.1° up to 1e5 and 1° at 1e6; 1e7 measured"
     );
     common::finish_bounded(ctx, cmds, &counters, &violations);
+}
+
+/// Scenes whose rays all start near their objects (within 90 % of their rebase
+/// distance: the project's scenes, the test objects) are specialised without
+/// the far-ray search; the same objects seen from afar keep it.
+#[test]
+fn only_scenes_that_reach_far_keep_the_far_ray_search() {
+    let (ctx, counters, mut cmds) = common::gpu();
+    for name in ["spheres.toml", "figure1_left.toml", "glass_vessel.toml"] {
+        let gpu = GpuScene::for_render(&ctx.device, &mut cmds, &common::project_scene(name)).unwrap();
+        assert!(!gpu.far_rays(), "{name} keeps the far-ray search");
+    }
+    let near = common::scene_with(common::test_objects());
+    let gpu = GpuScene::new(&ctx.device, &mut cmds, &near, &CellParams::default()).unwrap();
+    assert!(!gpu.far_rays(), "the test objects from the origin keep the far-ray search");
+    // The same objects from 1e3 units (their rebase distance is at most 64).
+    let far = GpuScene::with_origin(&ctx.device, &mut cmds, &near, &CellParams::default(), DVec3::splat(1e3)).unwrap();
+    assert!(far.far_rays(), "the test objects from 1e3 units leave the far-ray search out");
+    common::finish_bounded(ctx, cmds, &counters, &[]);
 }

@@ -10,5 +10,6 @@ mod covariance;
 mod far_views;
 mod geometry_gpu;
 mod offsets;
+mod parallel_rays;
 mod root_multiplicity;
 mod stress_geometry;
