@@ -552,7 +552,7 @@ fn shell_quote(s: &str) -> String {
 /// Writes `bytes` to `path` through a temporary file in the same folder and
 /// a rename.
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FarmError> {
-    crate::output::write_file_atomically(path, bytes).map_err(io(path))
+    crate::files::write_file_atomically(path, bytes).map_err(io(path))
 }
 
 #[cfg(test)]

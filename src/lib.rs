@@ -11,6 +11,7 @@
 pub mod bench;
 pub mod covariance;
 pub mod farm;
+pub mod files;
 pub mod filter_bench;
 pub mod geometry;
 pub mod hash;
@@ -54,7 +55,7 @@ pub enum RenderError {
     },
     /// Pixel bounds that are empty or outside the frame.
     #[error(transparent)]
-    Bounds(#[from] passes::bounds::BoundsError),
+    Bounds(#[from] passes::film::BoundsError),
     /// An accumulation that does not fit the renderer (another image size,
     /// crop or sample target).
     #[error("the accumulation does not fit this render: {0}")]

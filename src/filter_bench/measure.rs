@@ -6,9 +6,10 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use crate::files::write_all_or_nothing;
 use crate::geometry::CellParams;
 use crate::metrics::{change_error, flip_mean, mean_display_change, RELATIVE_MSE_EPSILON};
-use crate::output::{write_all_or_nothing, write_png};
+use crate::output::write_png;
 use crate::passes::render::PIXEL_FILTER_SIGMA;
 use crate::passes::{render, GpuScene, RenderOutput, RenderVariant};
 use crate::scene::{load_scene, Scene};

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use crate::output::{write_all_or_nothing, write_file_atomically};
+use crate::files::{write_all_or_nothing, write_file_atomically};
 use crate::plot::{write_log_log_plot, HLine, Series};
 
 use super::*;

@@ -3,7 +3,39 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::scene::{UvMapping, UvSettings};
+/// How texture coordinates (u, v) are laid on an object, in its own frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum UvMapping {
+    /// u = p · u_axis, v = p · v_axis (the axes' lengths set the scale).
+    Planar {
+        /// Gradient of u.
+        u_axis: DVec3,
+        /// Gradient of v.
+        v_axis: DVec3,
+    },
+    /// u = azimuth around +y / 2π + 1/2 (azimuth 0 along +x, toward +z),
+    /// v = angle from +y / π (0 at the top).
+    Spherical,
+    /// u as for `Spherical`, v = y.
+    Cylindrical,
+}
+
+/// Texture coordinates of an object: (u, v) = mapping(p) · scale + offset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvSettings {
+    /// The mapping.
+    pub mapping: UvMapping,
+    /// Repeats per unit of the mapping's coordinates.
+    pub scale: DVec2,
+    /// Offset added after scaling.
+    pub offset: DVec2,
+}
+
+impl Default for UvSettings {
+    fn default() -> Self {
+        Self { mapping: UvMapping::Spherical, scale: DVec2::ONE, offset: DVec2::ZERO }
+    }
+}
 
 /// (u, v) at `p` (object frame) and the gradients ∇u, ∇v there.
 pub fn object_uv(settings: &UvSettings, p: DVec3) -> (DVec2, DVec3, DVec3) {

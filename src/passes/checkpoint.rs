@@ -23,70 +23,11 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use super::bounds::PixelBounds;
+use super::film::{Accumulation, PixelBounds};
 use super::gpu::GpuAov;
-use super::render::RenderOutput;
 use crate::hash::Fnv1a;
 
 const MAGIC: &[u8; 8] = b"QRAYCKP1";
-
-/// The state of a render that can go on later: what
-/// [`super::Renderer::accumulation`] reads and [`super::Renderer::restore`]
-/// uploads.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Accumulation {
-    /// The whole frame's width and height.
-    pub frame_size: (u32, u32),
-    /// The pixels rendered.
-    pub bounds: PixelBounds,
-    /// Samples per pixel completed.
-    pub samples: u32,
-    /// Tiles of sample `samples` completed.
-    pub partial_tiles: u32,
-    /// GPU time of the samples so far (s).
-    pub render_seconds: f64,
-    /// Per pixel of `bounds`: the radiance sums and the finite-sample count.
-    pub sums: Vec<[f32; 4]>,
-    /// Per pixel: the largest sample's luminance and index.
-    pub max_sample: Vec<[f32; 2]>,
-    /// Per pixel: the AOVs of the pixel-centre ray.
-    pub aov: Vec<GpuAov>,
-}
-
-impl Accumulation {
-    /// The image of the work so far, `counts[i]` samples in pixel i (dropped
-    /// samples black); times and pass reports are left empty.
-    pub fn into_output(self, counts: &[u32]) -> RenderOutput {
-        let radiance = self
-            .sums
-            .iter()
-            .zip(counts)
-            .map(|(s, &c)| {
-                let n = c.max(1) as f32;
-                [s[0] / n, s[1] / n, s[2] / n]
-            })
-            .collect();
-        let dropped_samples =
-            self.sums.iter().zip(counts).map(|(s, &c)| (c as f64 - s[3] as f64).round().max(0.0) as u64).sum();
-        RenderOutput {
-            width: self.bounds.width(),
-            height: self.bounds.height(),
-            bounds: self.bounds,
-            frame_size: self.frame_size,
-            radiance,
-            aov: self.aov,
-            spp: self.samples,
-            partial_tiles: self.partial_tiles,
-            seconds: self.render_seconds,
-            render_seconds: self.render_seconds,
-            caustics: None,
-            volume_seconds: None,
-            dropped_samples,
-            max_sample: self.max_sample,
-            backend: None,
-        }
-    }
-}
 
 /// A checkpoint file's contents.
 #[derive(Clone, Debug, PartialEq)]
@@ -232,7 +173,7 @@ impl Checkpoint {
     /// place): a render killed while writing leaves the previous one.
     pub fn write(&self, path: &Path) -> Result<(), CheckpointError> {
         let bytes = self.to_bytes();
-        crate::output::write_file_atomically(path, &bytes)
+        crate::files::write_file_atomically(path, &bytes)
             .map_err(|source| CheckpointError::Io { path: path.into(), source })
     }
 

@@ -1,9 +1,9 @@
 //! GPU passes, one a file: the scene upload, the render pass, and the probe
 //! passes (rays, texture lookups) used by tests and benchmarks.
 
-pub mod bounds;
 pub mod caustics;
 pub mod checkpoint;
+pub mod film;
 pub mod gpu;
 pub mod outliers;
 pub mod probe;
@@ -14,11 +14,11 @@ pub mod tracer;
 pub mod variant;
 pub mod volume;
 
-pub use bounds::{PixelBounds, TileIndex};
 pub use caustics::{CausticMap, CausticReport};
-pub use checkpoint::{Accumulation, Checkpoint};
+pub use checkpoint::Checkpoint;
+pub use film::{Accumulation, PixelBounds, RenderOutput, TileIndex};
 pub use probe::ProbePass;
-pub use render::{render, RecordedPath, RenderOutput, Renderer};
+pub use render::{render, RecordedPath, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene, LoopBudget, LOOP_LIMIT};
 pub use texprobe::TexProbePass;
 pub use tracer::Tracer;

@@ -4,9 +4,8 @@
 
 use std::sync::Arc;
 
-use super::bounds::PixelBounds;
 use super::caustics::{emitters, CausticMap, CausticReport};
-use super::checkpoint::Accumulation;
+use super::film::{Accumulation, PixelBounds, RenderOutput};
 use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathRecord, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::tracer::Tracer;
@@ -24,73 +23,6 @@ use crate::{shaders, RenderError};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
 const TILE: u32 = 256;
-
-/// What a render produces: linear radiance and AOVs, row 0 at the top, for
-/// the pixels of `bounds` (the whole frame, or a crop or tile of it).
-pub struct RenderOutput {
-    /// Width in pixels (of `bounds`).
-    pub width: u32,
-    /// Height in pixels (of `bounds`).
-    pub height: u32,
-    /// The part of the frame the image covers.
-    pub bounds: PixelBounds,
-    /// The whole frame's width and height.
-    pub frame_size: (u32, u32),
-    /// Mean radiance per pixel (linear RGB).
-    pub radiance: Vec<[f32; 3]>,
-    /// Depth, normal and albedo per pixel from the pixel-centre ray.
-    pub aov: Vec<GpuAov>,
-    /// Samples per pixel taken (every pixel has at least this many; an
-    /// interrupted render's pixels in the tiles of its next sample that
-    /// finished have one more, see `partial_tiles`).
-    pub spp: u32,
-    /// Tiles of sample `spp` that were finished when the render stopped
-    /// (0 for a render that ran to the end).
-    pub partial_tiles: u32,
-    /// GPU time of the work in seconds (timestamps), the caustic and volume
-    /// passes included.
-    pub seconds: f64,
-    /// GPU time of the render pass alone (the samples) in seconds.
-    pub render_seconds: f64,
-    /// What the caustic passes did, when they ran.
-    pub caustics: Option<CausticReport>,
-    /// GPU time of the volume pass (s), when it ran.
-    pub volume_seconds: Option<f64>,
-    /// Samples whose radiance came out NaN or infinite, counted as black
-    /// (0 in every test; the CLI warns otherwise).
-    pub dropped_samples: u64,
-    /// The largest single sample per pixel: its luminance (Rec. 709 Y of
-    /// the sample's linear radiance) and the sample index that brought it
-    /// (empty for an image read from a file). The outlier report compares it
-    /// with the bound the scene allows (`passes::outliers`).
-    pub max_sample: Vec<[f32; 2]>,
-    /// The backend every tracing pass ran on (`None` for an image read from
-    /// a file).
-    pub backend: Option<Backend>,
-}
-
-impl RenderOutput {
-    /// An image without render data (AOVs, times): one read from a file.
-    pub fn from_radiance(width: u32, height: u32, radiance: Vec<[f32; 3]>) -> Self {
-        Self {
-            width,
-            height,
-            bounds: PixelBounds::full(width, height),
-            frame_size: (width, height),
-            radiance,
-            aov: vec![],
-            spp: 0,
-            partial_tiles: 0,
-            seconds: 0.0,
-            render_seconds: 0.0,
-            caustics: None,
-            volume_seconds: None,
-            dropped_samples: 0,
-            max_sample: vec![],
-            backend: None,
-        }
-    }
-}
 
 /// The events of one recorded path ([`Renderer::trace_path`]).
 #[derive(Clone, Debug, Default)]

@@ -10,6 +10,7 @@ use super::gpu::{GpuCell, GpuLight, GpuLoopBudget, GpuMaterial, GpuObject, GpuPe
 use super::IntersectMode;
 use crate::geometry::{Aabb, CellParams};
 use crate::sampling::envmap::EnvironmentMap;
+use crate::scene::maps as scene_maps;
 use crate::scene::{Light, Scene, TextureImage};
 use crate::shader_interface::{
     BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_LOOP_BUDGET, BINDING_MATERIALS,
@@ -17,7 +18,6 @@ use crate::shader_interface::{
     SPEC_LOOP_BUDGET,
 };
 use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
-use crate::texture::scene_maps;
 use crate::vk::{vk, AccelerationStructure, Access, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
 use crate::RenderError;
 

@@ -106,7 +106,7 @@ pub fn write_log_log_plot(
     let image = render_log_log_plot(DEFAULT_PLOT_SIZE, title, x_label, y_label, series, hlines)?;
     let mut png = Cursor::new(Vec::new());
     image.write_to(&mut png, ImageFormat::Png)?;
-    crate::output::write_file_atomically(path, png.get_ref())
+    crate::files::write_file_atomically(path, png.get_ref())
         .map_err(|source| PlotError::Io { path: path.to_path_buf(), source })
 }
 

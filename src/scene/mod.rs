@@ -3,11 +3,14 @@
 //! TOML (documented field by field in `scenes/README.md`).
 
 pub mod file;
+pub mod maps;
 pub mod preset;
 
-use glam::{DAffine3, DVec2, DVec3, Vec3};
+use glam::{DAffine3, DVec3, Vec3};
 
+pub use crate::geometry::uv::{UvMapping, UvSettings};
 use crate::geometry::FunctionalObject;
+pub use crate::texture::TextureImage;
 
 pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME, MAX_IMAGE_SIZE};
 
@@ -235,55 +238,6 @@ impl Material {
             medium: None,
         }
     }
-}
-
-/// How texture coordinates (u, v) are laid on an object, in its own frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum UvMapping {
-    /// u = p · u_axis, v = p · v_axis (the axes' lengths set the scale).
-    Planar {
-        /// Gradient of u.
-        u_axis: DVec3,
-        /// Gradient of v.
-        v_axis: DVec3,
-    },
-    /// u = azimuth around +y / 2π + 1/2 (azimuth 0 along +x, toward +z),
-    /// v = angle from +y / π (0 at the top).
-    Spherical,
-    /// u as for `Spherical`, v = y.
-    Cylindrical,
-}
-
-/// Texture coordinates of an object: (u, v) = mapping(p) · scale + offset.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct UvSettings {
-    /// The mapping.
-    pub mapping: UvMapping,
-    /// Repeats per unit of the mapping's coordinates.
-    pub scale: DVec2,
-    /// Offset added after scaling.
-    pub offset: DVec2,
-}
-
-impl Default for UvSettings {
-    fn default() -> Self {
-        Self { mapping: UvMapping::Spherical, scale: DVec2::ONE, offset: DVec2::ZERO }
-    }
-}
-
-/// A texture with its mip chain, in linear RGBA (colour maps already
-/// sRGB-decoded). Level 0 is `width` x `height` (powers of two); each next
-/// level halves both, down to 1 x 1.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TextureImage {
-    /// Where it came from (a path, or a description of a generated texture).
-    pub source: String,
-    /// Width of level 0.
-    pub width: u32,
-    /// Height of level 0.
-    pub height: u32,
-    /// Texels of every level, row 0 at the top (v = 0), row-major.
-    pub levels: Vec<Vec<[f32; 4]>>,
 }
 
 /// A functional object placed in the world.

@@ -20,7 +20,7 @@
 use std::fmt;
 use std::sync::OnceLock;
 
-use crate::scene::TextureImage;
+use super::TextureImage;
 use crate::texture::srgb_to_linear;
 
 /// A GPU storage encoding of RGBA texels.

@@ -41,10 +41,10 @@
 //! instead ([`lean`]).
 
 pub mod encoding;
+pub mod environment;
 pub mod lean;
 mod procedural;
 mod resample;
-pub mod scene_maps;
 
 use std::io;
 use std::path::{Path, PathBuf};
@@ -52,7 +52,20 @@ use std::path::{Path, PathBuf};
 pub use procedural::{bump_heights, checker, normals_from_heights};
 pub use resample::{build_mips, resample_to_power_of_two};
 
-pub use crate::scene::TextureImage;
+/// A texture with its mip chain, in linear RGBA (colour maps already
+/// sRGB-decoded). Level 0 is `width` x `height` (powers of two); each next
+/// level halves both, down to 1 x 1.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureImage {
+    /// Where it came from (a path, or a description of a generated texture).
+    pub source: String,
+    /// Width of level 0.
+    pub width: u32,
+    /// Height of level 0.
+    pub height: u32,
+    /// Texels of every level, row 0 at the top (v = 0), row-major.
+    pub levels: Vec<Vec<[f32; 4]>>,
+}
 
 /// Largest accepted texture width or height, in texels.
 pub const MAX_TEXTURE_SIZE: u32 = 16384;

@@ -7,6 +7,7 @@
 mod common;
 
 mod interface;
+mod layers;
 mod parser_fuzz;
 mod scene_errors;
 mod texture_extremes;

@@ -8,8 +8,8 @@ use super::super::{
     MaterialMaps, Preset, Scene, UvMapping, UvSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, Quadric};
-use crate::sampling::envmap::procedural_sky;
 use crate::texture;
+use crate::texture::environment::procedural_sky;
 
 const CAMERA: &str = "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n";
 

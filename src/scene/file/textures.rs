@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 use super::{EnvironmentMapSettings, MaterialMaps, TextureImage};
-use crate::sampling::envmap::procedural_sky;
+use crate::texture::environment::procedural_sky;
 use crate::texture::{self, TextureKind, TextureUsage};
 
 use super::*;

@@ -5,9 +5,9 @@
 
 use std::collections::HashMap;
 
-use super::encoding::MapContent;
-use super::lean;
-use crate::scene::{Scene, TextureImage};
+use super::Scene;
+use crate::texture::encoding::MapContent;
+use crate::texture::{lean, TextureImage};
 
 /// What each texture of the scene holds: colour if every use of it is as an
 /// albedo map or the environment (both sRGB-decoded when read from PNG or

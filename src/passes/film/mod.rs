@@ -1,0 +1,139 @@
+//! The film: what a render accumulates and what it produces, for the pixels
+//! of its bounds. `RenderOutput` is the image with its AOVs and reports;
+//! `Accumulation` the state between samples that a checkpoint stores and a
+//! resumed render goes on from; `PixelBounds` (`bounds.rs`) the part of the
+//! frame rendered. The render pass fills them, checkpoints store them and
+//! `output` writes them, so none of those needs another.
+
+pub mod bounds;
+
+pub use bounds::{BoundsError, PixelBounds, TileIndex};
+
+use super::caustics::CausticReport;
+use super::gpu::GpuAov;
+use crate::vk::Backend;
+
+/// What a render produces: linear radiance and AOVs, row 0 at the top, for
+/// the pixels of `bounds` (the whole frame, or a crop or tile of it).
+pub struct RenderOutput {
+    /// Width in pixels (of `bounds`).
+    pub width: u32,
+    /// Height in pixels (of `bounds`).
+    pub height: u32,
+    /// The part of the frame the image covers.
+    pub bounds: PixelBounds,
+    /// The whole frame's width and height.
+    pub frame_size: (u32, u32),
+    /// Mean radiance per pixel (linear RGB).
+    pub radiance: Vec<[f32; 3]>,
+    /// Depth, normal and albedo per pixel from the pixel-centre ray.
+    pub aov: Vec<GpuAov>,
+    /// Samples per pixel taken (every pixel has at least this many; an
+    /// interrupted render's pixels in the tiles of its next sample that
+    /// finished have one more, see `partial_tiles`).
+    pub spp: u32,
+    /// Tiles of sample `spp` that were finished when the render stopped
+    /// (0 for a render that ran to the end).
+    pub partial_tiles: u32,
+    /// GPU time of the work in seconds (timestamps), the caustic and volume
+    /// passes included.
+    pub seconds: f64,
+    /// GPU time of the render pass alone (the samples) in seconds.
+    pub render_seconds: f64,
+    /// What the caustic passes did, when they ran.
+    pub caustics: Option<CausticReport>,
+    /// GPU time of the volume pass (s), when it ran.
+    pub volume_seconds: Option<f64>,
+    /// Samples whose radiance came out NaN or infinite, counted as black
+    /// (0 in every test; the CLI warns otherwise).
+    pub dropped_samples: u64,
+    /// The largest single sample per pixel: its luminance (Rec. 709 Y of
+    /// the sample's linear radiance) and the sample index that brought it
+    /// (empty for an image read from a file). The outlier report compares it
+    /// with the bound the scene allows (`passes::outliers`).
+    pub max_sample: Vec<[f32; 2]>,
+    /// The backend every tracing pass ran on (`None` for an image read from
+    /// a file).
+    pub backend: Option<Backend>,
+}
+
+impl RenderOutput {
+    /// An image without render data (AOVs, times): one read from a file.
+    pub fn from_radiance(width: u32, height: u32, radiance: Vec<[f32; 3]>) -> Self {
+        Self {
+            width,
+            height,
+            bounds: PixelBounds::full(width, height),
+            frame_size: (width, height),
+            radiance,
+            aov: vec![],
+            spp: 0,
+            partial_tiles: 0,
+            seconds: 0.0,
+            render_seconds: 0.0,
+            caustics: None,
+            volume_seconds: None,
+            dropped_samples: 0,
+            max_sample: vec![],
+            backend: None,
+        }
+    }
+}
+
+/// The state of a render that can go on later: what
+/// [`crate::passes::Renderer::accumulation`] reads and [`crate::passes::Renderer::restore`]
+/// uploads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accumulation {
+    /// The whole frame's width and height.
+    pub frame_size: (u32, u32),
+    /// The pixels rendered.
+    pub bounds: PixelBounds,
+    /// Samples per pixel completed.
+    pub samples: u32,
+    /// Tiles of sample `samples` completed.
+    pub partial_tiles: u32,
+    /// GPU time of the samples so far (s).
+    pub render_seconds: f64,
+    /// Per pixel of `bounds`: the radiance sums and the finite-sample count.
+    pub sums: Vec<[f32; 4]>,
+    /// Per pixel: the largest sample's luminance and index.
+    pub max_sample: Vec<[f32; 2]>,
+    /// Per pixel: the AOVs of the pixel-centre ray.
+    pub aov: Vec<GpuAov>,
+}
+
+impl Accumulation {
+    /// The image of the work so far, `counts[i]` samples in pixel i (dropped
+    /// samples black); times and pass reports are left empty.
+    pub fn into_output(self, counts: &[u32]) -> RenderOutput {
+        let radiance = self
+            .sums
+            .iter()
+            .zip(counts)
+            .map(|(s, &c)| {
+                let n = c.max(1) as f32;
+                [s[0] / n, s[1] / n, s[2] / n]
+            })
+            .collect();
+        let dropped_samples =
+            self.sums.iter().zip(counts).map(|(s, &c)| (c as f64 - s[3] as f64).round().max(0.0) as u64).sum();
+        RenderOutput {
+            width: self.bounds.width(),
+            height: self.bounds.height(),
+            bounds: self.bounds,
+            frame_size: self.frame_size,
+            radiance,
+            aov: self.aov,
+            spp: self.samples,
+            partial_tiles: self.partial_tiles,
+            seconds: self.render_seconds,
+            render_seconds: self.render_seconds,
+            caustics: None,
+            volume_seconds: None,
+            dropped_samples,
+            max_sample: self.max_sample,
+            backend: None,
+        }
+    }
+}
