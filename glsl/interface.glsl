@@ -1,5 +1,5 @@
-// Data layouts shared with the host (src/passes/gpu.rs, checked there by
-// size asserts). Binding numbers come from src/shader_interface.rs through
+// Data layouts shared with the host (src/passes/gpu.rs: host_layouts, which
+// tests/scene/interface.rs checks member by member against the SPIR-V). Binding numbers come from src/shader_interface.rs through
 // build.rs as #defines. All blocks use the scalar layout.
 #ifndef INTERFACE_GLSL
 #define INTERFACE_GLSL

@@ -111,9 +111,11 @@ pub(crate) struct QualityArgs {
     pub(crate) max_depth: Option<u32>,
     /// Texture filtering (overrides `image.filter`): `none` (bilinear lookups
     /// of the finest mip level; with many samples per pixel, the reference),
-    /// `ray-cones` (EWA lookups over ray-cone footprints, Akenine-Möller et
-    /// al. 2021) or `covariance` (EWA lookups over covariance footprints
-    /// carried along the path).
+    /// `ray-cones` (prefiltered lookups over ray-cone footprints,
+    /// Akenine-Möller et al. 2021) or `covariance` (prefiltered lookups over
+    /// covariance footprints carried along the path). The lookups are
+    /// trilinear probes along the footprint's major axis (EWA is the
+    /// reference lookup of the tests and benchmarks).
     #[arg(long)]
     pub(crate) filter: Option<FilterMode>,
     /// Caustic rays per light and light sample (overrides `caustics.rays`; 0

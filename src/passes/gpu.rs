@@ -1,5 +1,6 @@
-//! Host mirrors of the shader structs in `glsl/interface.glsl` (scalar
-//! layout), with compile-time size checks.
+//! Host mirrors of the shader structs in `glsl/interface.glsl` and the other
+//! shaders (scalar layout); `host_layouts` lists their members, which
+//! `tests/scene/interface.rs` checks one by one against the SPIR-V.
 
 use bytemuck::{Pod, Zeroable};
 
