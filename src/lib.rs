@@ -8,6 +8,9 @@
 //! - [`passes`]: GPU passes.
 //! - [`output`]: PNG and EXR files, written atomically.
 
+// Every `unsafe` block says why it is sound (clippy runs with -D warnings).
+#![warn(clippy::undocumented_unsafe_blocks)]
+
 pub mod bench;
 pub mod covariance;
 pub mod farm;

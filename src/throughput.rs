@@ -165,6 +165,8 @@ pub struct Report {
 fn children_cpu_seconds() -> f64 {
     let mut usage = std::mem::MaybeUninit::<libc::rusage>::zeroed();
     // SAFETY: getrusage writes a rusage into the pointer it is given.
+    // RUSAGE_CHILDREN is a valid `who` and the pointer is to a live, writable rusage; even if the call
+    // failed, the zeroed value is a valid rusage (plain integers), so `assume_init` is sound either way.
     let usage = unsafe {
         libc::getrusage(libc::RUSAGE_CHILDREN, usage.as_mut_ptr());
         usage.assume_init()

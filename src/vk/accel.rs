@@ -9,6 +9,8 @@ use gpu_allocator::MemoryLocation;
 use super::{Access, Buffer, Commands, Device, VkError};
 
 /// An acceleration structure and the buffer that stores it.
+// Release order: `Drop::drop` destroys `raw` before any field drops, so `buffer`, the structure's storage,
+// outlives it.
 pub struct AccelerationStructure {
     device: Arc<Device>,
     /// The handle.
@@ -49,6 +51,10 @@ impl AccelerationStructure {
             .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
             .geometries(&geometries);
         let mut sizes = vk::AccelerationStructureBuildSizesInfoKHR::default();
+        // SAFETY: `device.accel` was loaded for `device.raw`, which enabled VK_KHR_acceleration_structure and
+        // its accelerationStructure feature (required of every device); `build_info` -> `geometries` and the
+        // count slice (one maximum primitive count per geometry) are locals alive until the call returns. The
+        // query ignores the geometry's device addresses.
         unsafe {
             device.accel.get_acceleration_structure_build_sizes(
                 vk::AccelerationStructureBuildTypeKHR::DEVICE,
@@ -68,10 +74,15 @@ impl AccelerationStructure {
             .buffer(buffer.raw)
             .size(sizes.acceleration_structure_size)
             .ty(ty);
+        // SAFETY: `buffer` is live, bound to memory and created with ACCELERATION_STRUCTURE_STORAGE_KHR usage
+        // and at least `acceleration_structure_size` bytes; offset 0 is a multiple of 256; `create` lives
+        // until the call returns. `buffer` moves into `this`, so it outlives the structure (see the struct).
         let raw = unsafe { device.accel.create_acceleration_structure(&create, None) }?;
         let this = Self {
             device: device.clone(),
             raw,
+            // SAFETY: `raw` was just created on this device, backed by a bound buffer; the info is a
+            // temporary alive for the call.
             address: unsafe {
                 device.accel.get_acceleration_structure_device_address(
                     &vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(raw),
@@ -114,6 +125,9 @@ impl AccelerationStructure {
                 max_z: b[5],
             })
             .collect();
+        // SAFETY: `positions` is a live Vec of `AabbPositionsKHR` (repr(C), six f32, no padding), so all
+        // `size_of_val` bytes from its pointer are initialised, and u8 needs no alignment; `bytes` is used
+        // only while `positions` lives (copied by `with_data` below).
         let bytes = unsafe {
             std::slice::from_raw_parts(positions.as_ptr() as *const u8, std::mem::size_of_val(positions.as_slice()))
         };
@@ -149,6 +163,9 @@ impl AccelerationStructure {
                 },
             })
             .collect();
+        // SAFETY: `raw_instances` is a live Vec of `AccelerationStructureInstanceKHR`, repr(C) and 64 bytes
+        // without padding (a 48-byte matrix, two packed u32 fields, an 8-byte union whose variants both fill
+        // it), so all its bytes are initialised; `bytes` is used only while `raw_instances` lives.
         let bytes = unsafe {
             std::slice::from_raw_parts(
                 raw_instances.as_ptr() as *const u8,
@@ -173,6 +190,11 @@ impl AccelerationStructure {
 
 impl Drop for AccelerationStructure {
     fn drop(&mut self) {
+        // SAFETY: `self.raw` was created in `build` on `self.device` (a field, alive here) and is destroyed
+        // once, here, while its storage `buffer` still exists (fields drop after this body); no pending build
+        // or trace uses it, as `Commands::run` waits before returning. A top level built over this bottom
+        // level must not be traced afterwards: that is the caller's to ensure (`Instance` borrows the bottom
+        // level only for the build).
         unsafe { self.device.accel.destroy_acceleration_structure(self.raw, None) };
     }
 }

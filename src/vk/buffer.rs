@@ -39,7 +39,11 @@ impl Buffer {
             .size(size)
             .usage(usage | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: `device.raw` is alive (the Arc is held); `info` is a local without pNext: a nonzero size,
+        // exclusive sharing, and SHADER_DEVICE_ADDRESS usage, which needs the bufferDeviceAddress feature
+        // that `Device::create` enables.
         let raw = unsafe { device.raw.create_buffer(&info, None) }?;
+        // SAFETY: `raw` was just created on this device and is not destroyed yet.
         let requirements = unsafe { device.raw.get_buffer_memory_requirements(raw) };
         let allocation = device.allocator.lock().expect("allocator lock").allocate(&AllocationCreateDesc {
             name,
@@ -51,12 +55,18 @@ impl Buffer {
         let allocation = match allocation {
             Ok(a) => a,
             Err(e) => {
+                // SAFETY: `raw` was created above, has no memory bound and was never recorded into a command
+                // buffer; it is not used after this.
                 unsafe { device.raw.destroy_buffer(raw, None) };
                 return Err(VkError::Allocation(format!("{name}: {e}")));
             }
         };
+        // SAFETY: `allocation` was made by this device's allocator from `raw`'s own memory requirements, so
+        // its memory type, size and offset alignment fit; `raw` has no memory bound yet.
         if let Err(e) = unsafe { device.raw.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) } {
             let _ = device.allocator.lock().expect("allocator lock").free(allocation);
+            // SAFETY: binding failed, so `raw` is unbound and was never used; its allocation was freed just
+            // above and the handle is not used after this.
             unsafe { device.raw.destroy_buffer(raw, None) };
             return Err(e.into());
         }
@@ -79,6 +89,9 @@ impl Buffer {
     /// The buffer's device address.
     pub fn device_address(&self) -> vk::DeviceAddress {
         let info = vk::BufferDeviceAddressInfo::default().buffer(self.raw);
+        // SAFETY: `self.raw` is owned by `self` (destroyed only in Drop), bound to memory (`Buffer::new`
+        // returns only after binding) and created with SHADER_DEVICE_ADDRESS usage on a device with
+        // bufferDeviceAddress enabled; `info` lives for the call.
         unsafe { self.device.raw.get_buffer_device_address(&info) }
     }
 
@@ -118,6 +131,11 @@ impl Drop for Buffer {
         if let Some(a) = self.allocation.take() {
             let _ = self.device.allocator.lock().map(|mut al| al.free(a));
         }
+        // SAFETY: `self.raw` was created by `Buffer::new` on `self.device` and is destroyed once, here; the
+        // device outlives it (`device` is a field, dropped after this body). No submission still uses it:
+        // `Commands::run` waits on its fence before returning, and callers keep a buffer alive across the
+        // `run` that records it. Its memory was freed just above, which Vulkan allows before the buffer is
+        // destroyed.
         unsafe { self.device.raw.destroy_buffer(self.raw, None) };
     }
 }

@@ -132,7 +132,11 @@ impl Capabilities {
     /// Reads what `physical` offers. Feature structures of an extension are
     /// chained only when the device lists the extension.
     pub fn query(instance: &ash::Instance, physical: vk::PhysicalDevice) -> Self {
+        // SAFETY: the callers (`Device::select`, `survey`) pass a `physical` enumerated from `instance`,
+        // which is borrowed alive for the call; nothing checks this for other callers of this public
+        // function.
         let props = unsafe { instance.get_physical_device_properties(physical) };
+        // SAFETY: as above; ash sizes the returned Vec from the reported count.
         let extensions = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
         let vulkan_1_2 = props.api_version >= vk::API_VERSION_1_2;
         let has = |name: &CStr| has_extension(&extensions, name);
@@ -159,6 +163,9 @@ impl Capabilities {
         if has_rt {
             features = features.push_next(&mut frt);
         }
+        // SAFETY: `physical` belongs to `instance` (API 1.2, so the command is core); each struct in the
+        // chain is a live local, chained only where valid: the Vulkan 1.2 features where the device reports
+        // 1.2, an extension's features where the device lists the extension.
         unsafe { instance.get_physical_device_features2(physical, &mut features) };
         let base = features.features;
 
@@ -171,8 +178,11 @@ impl Capabilities {
         if has_rt {
             props2 = props2.push_next(&mut rt_props);
         }
+        // SAFETY: as for the features: driver properties (core 1.2) only on a 1.2 device,
+        // ray-tracing-pipeline properties only where the device lists the extension; both are live locals.
         unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
 
+        // SAFETY: `physical` belongs to the live `instance`, as above.
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let compute = families.iter().find(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE));
         let ray_tracing_pipeline = has_rt && frt.ray_tracing_pipeline == vk::TRUE;
@@ -290,11 +300,13 @@ pub struct Survey {
 /// Lists the Vulkan devices and what each offers; needs no validation layer.
 pub fn survey() -> Result<Survey, super::VkError> {
     let instance = super::Instance::new(false)?;
+    // SAFETY: `instance.raw` is the instance created just above, alive until this function returns.
     let physical = unsafe { instance.raw.enumerate_physical_devices() }?;
     let mut devices = Vec::new();
     let mut best: Option<(u32, usize, Backend)> = None;
     for (index, &pd) in physical.iter().enumerate() {
         let caps = Capabilities::query(&instance.raw, pd);
+        // SAFETY: `pd` was just enumerated from `instance.raw`, which is alive.
         let rank = preference(unsafe { instance.raw.get_physical_device_properties(pd) }.device_type);
         if let Some(backend) = caps.auto_backend() {
             if best.is_none_or(|(r, _, _)| rank < r) {

@@ -26,21 +26,30 @@ impl Commands {
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(device.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        // SAFETY: `raw` is the live device (held by the Arc); `pool_info` is a local naming
+        // `device.queue_family`, the family the device was created with a queue of.
         let pool = unsafe { raw.create_command_pool(&pool_info, None) }?;
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
+        // SAFETY: `pool` was just created on `raw` and no other thread has it; `alloc` asks for one primary
+        // command buffer from it.
         let cmd = match unsafe { raw.allocate_command_buffers(&alloc) } {
             Ok(c) => c[0],
             Err(e) => {
+                // SAFETY: allocation failed, so `pool` holds no command buffers; it is not used after this.
                 unsafe { raw.destroy_command_pool(pool, None) };
                 return Err(e.into());
             }
         };
+        // SAFETY: `raw` is the live device; the create info is a default one (unsignalled, no pNext), alive
+        // for the call.
         let fence = match unsafe { raw.create_fence(&vk::FenceCreateInfo::default(), None) } {
             Ok(f) => f,
             Err(e) => {
+                // SAFETY: `cmd` was allocated but never recorded or submitted, so destroying `pool` (which
+                // frees it) is allowed; neither is used after this.
                 unsafe { raw.destroy_command_pool(pool, None) };
                 return Err(e.into());
             }
@@ -79,6 +88,9 @@ impl Commands {
 
 impl Drop for Commands {
     fn drop(&mut self) {
+        // SAFETY: after device_wait_idle no submission of `cmd` is pending and nothing waits on the fence;
+        // the fence and the pool (which frees `cmd`) were created in `new` on `self.device`, are destroyed
+        // once, here, and `self.device` (a field) outlives this body.
         unsafe {
             let _ = self.device.raw.device_wait_idle();
             self.device.raw.destroy_fence(self.fence, None);

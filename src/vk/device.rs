@@ -21,6 +21,8 @@ pub const SETUP_HINT: &str =
     "run `make setup` (installs Mesa's lavapipe with VK_KHR_ray_query from bookworm-backports on Debian 12)";
 
 /// A logical device with one compute queue and a memory allocator.
+// Release order: `Drop::drop` waits for idle, drops the `ManuallyDrop` allocator and destroys the device, all
+// before any field drops; `instance` (an Arc) is therefore released only after the device is gone.
 pub struct Device {
     /// The instance (kept alive as long as the device).
     pub instance: Arc<Instance>,
@@ -72,10 +74,13 @@ pub struct AccelProperties {
 #[cfg(feature = "viewer")]
 fn surface_shortcomings(instance: &ash::Instance, pd: vk::PhysicalDevice, surface: &super::Surface) -> Vec<String> {
     let mut missing = Vec::new();
+    // SAFETY: `pd` was enumerated from `instance` by `Device::select`, and `instance` is borrowed alive for
+    // the call; ash sizes the returned Vec from the reported count.
     let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
     if !exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == ash::khr::swapchain::NAME).unwrap_or(false)) {
         missing.push("VK_KHR_swapchain".to_string());
     }
+    // SAFETY: as above, `pd` is a physical device of the live `instance`.
     let family = unsafe { instance.get_physical_device_queue_family_properties(pd) }
         .iter()
         .position(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE));
@@ -115,12 +120,15 @@ impl Device {
         swapchain: bool,
     ) -> Result<Arc<Self>, VkError> {
         let raw_instance = &instance.raw;
+        // SAFETY: `raw_instance` is the live instance owned by `instance`, an Arc held for the whole
+        // function.
         let devices = unsafe { raw_instance.enumerate_physical_devices() }.map_err(|e| {
             VkError::NoSuitableDevice(format!("the Vulkan driver lists no devices ({e}).\nTo fix: {SETUP_HINT}"))
         })?;
         let mut report = Vec::new();
         let mut fits = Vec::new();
         for &pd in &devices {
+            // SAFETY: `pd` was just enumerated from `raw_instance`.
             let props = unsafe { raw_instance.get_physical_device_properties(pd) };
             let caps = Capabilities::query(raw_instance, pd);
             let extra = more(raw_instance, pd);
@@ -155,7 +163,10 @@ impl Device {
         swapchain: bool,
     ) -> Result<Arc<Self>, VkError> {
         let raw_instance = &instance.raw;
+        // SAFETY: `physical` was enumerated from `raw_instance` in `select`; `instance` keeps the instance
+        // alive.
         let properties = unsafe { raw_instance.get_physical_device_properties(physical) };
+        // SAFETY: as above.
         let queue_family = unsafe { raw_instance.get_physical_device_queue_family_properties(physical) }
             .iter()
             .position(|q| q.queue_flags.contains(vk::QueueFlags::COMPUTE))
@@ -177,6 +188,9 @@ impl Device {
 
         let mut supported12 = vk::PhysicalDeviceVulkan12Features::default();
         let mut supported = vk::PhysicalDeviceFeatures2::default().push_next(&mut supported12);
+        // SAFETY: `physical` belongs to `raw_instance` (API 1.2, so the command is core); the chain holds
+        // only `supported12`, a live local, and the device reports Vulkan 1.2 (`select` takes only devices
+        // with a backend, and every backend needs 1.2).
         unsafe { raw_instance.get_physical_device_features2(physical, &mut supported) };
         let base_features = vk::PhysicalDeviceFeatures::default().shader_float64(true).shader_int64(true);
 
@@ -201,7 +215,16 @@ impl Device {
             .queue_create_infos(&queue_info)
             .enabled_extension_names(&ext_names)
             .push_next(&mut features);
+        // SAFETY: `info` and what it points to (`queue_info` with `priorities`, `ext_names`, the chain
+        // `features` -> `f12`, `fas`, `frq`, `frt`) are locals alive until the call returns, and the names
+        // are `&'static CStr`s. Every extension is one the device lists and every feature one it supports:
+        // `select` took a device whose `Capabilities` lack nothing for a backend (acceleration structures,
+        // deferred host operations, bufferDeviceAddress, scalarBlockLayout, non-uniform indexing, float64,
+        // int64, int64 atomics); ray queries and pipelines are chained only where `caps` found them;
+        // host_query_reset is copied from the device; the swapchain extension is asked for only by
+        // `for_surface`, whose check requires it.
         let raw = unsafe { raw_instance.create_device(physical, &info, None) }?;
+        // SAFETY: `raw` was just created with one queue (index 0) of `queue_family`, as `queue_info` asked.
         let queue = unsafe { raw.get_device_queue(queue_family, 0) };
         let accel = ash::khr::acceleration_structure::Device::new(raw_instance, &raw);
         let ray_tracing = caps.pipeline_limits.map(|limits| RayTracing {
@@ -212,6 +235,9 @@ impl Device {
         let mut as_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
         let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut as_props).push_next(&mut maintenance3);
+        // SAFETY: `physical` belongs to `raw_instance`; the chain holds two live locals:
+        // acceleration-structure properties (the device lists and enabled VK_KHR_acceleration_structure) and
+        // maintenance-3 properties (core since Vulkan 1.1).
         unsafe { raw_instance.get_physical_device_properties2(physical, &mut props2) };
         let accel_properties = AccelProperties {
             min_scratch_offset_alignment: as_props.min_acceleration_structure_scratch_offset_alignment,
@@ -294,6 +320,10 @@ impl Device {
 
 impl Drop for Device {
     fn drop(&mut self) {
+        // SAFETY: every object made from this device holds an `Arc<Device>`, so all of them are destroyed and
+        // no other thread can use the device or its queue; after the wait no submission is pending. The
+        // allocator frees its memory blocks when dropped, so it goes first, exactly once and is never touched
+        // again; then the device is destroyed once. `instance` (a field) drops after this body.
         unsafe {
             let _ = self.raw.device_wait_idle();
             ManuallyDrop::drop(&mut self.allocator);

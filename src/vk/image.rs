@@ -79,9 +79,15 @@ impl Image {
         usage: vk::ImageUsageFlags,
     ) -> Result<Self, VkError> {
         let info = image_info(extent, levels, format, usage);
+        // SAFETY: `device.raw` is alive; `info` (from `image_info`, no pNext) is a 2D, single-layer,
+        // optimally tiled image in layout UNDEFINED. That `format` supports `usage` at this extent and level
+        // count is the caller's choice, not checked here (the scene's textures are checked with
+        // `Image::memory_bytes` first).
         let raw = unsafe { device.raw.create_image(&info, None) }?;
         let mut this =
             Self { device: device.clone(), raw, view: vk::ImageView::null(), allocation: None, format, extent, levels };
+        // SAFETY: `raw` was just created on this device; `this` owns it from here on and destroys it on every
+        // error path.
         let requirements = unsafe { device.raw.get_image_memory_requirements(raw) };
         let allocation = device
             .allocator
@@ -95,6 +101,8 @@ impl Image {
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
             .map_err(|e| VkError::Allocation(format!("{name}: {e}")))?;
+        // SAFETY: `allocation` was made by this device's allocator from `raw`'s own requirements, so memory
+        // type, size and offset alignment fit, and `raw` has no memory bound yet.
         unsafe { device.raw.bind_image_memory(raw, allocation.memory(), allocation.offset()) }?;
         this.allocation = Some(allocation);
         let view_info = vk::ImageViewCreateInfo::default()
@@ -102,6 +110,9 @@ impl Image {
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
             .subresource_range(this.all_levels());
+        // SAFETY: `raw` is live and now bound to memory; the view has the image's format and 2D type and
+        // covers its `levels` levels and one layer of the COLOR aspect; `view_info` lives until the call
+        // returns. On error `this` drops, destroying the image and freeing its memory.
         this.view = unsafe { device.raw.create_image_view(&view_info, None) }?;
         Ok(this)
     }
@@ -125,6 +136,8 @@ impl Image {
         texel_bytes: u64,
         usage: vk::ImageUsageFlags,
     ) -> Result<Option<u64>, VkError> {
+        // SAFETY: `device.physical` is the physical device `device.raw` was made on, from the live
+        // `device.instance`; the other arguments are plain values.
         let limits = unsafe {
             device.instance.raw.get_physical_device_image_format_properties(
                 device.physical,
@@ -151,8 +164,13 @@ impl Image {
         let info = image_info(extent, levels, format, usage);
         // A device that cannot even describe the image (out of memory for
         // its bookkeeping, say) cannot make it: not an error, a "no".
+        // SAFETY: as in `with_levels`: a live device and a local create info; the format supports `usage`
+        // (the query above succeeded) and the extent and level count are within its limits (checked just
+        // above).
         let Ok(raw) = (unsafe { device.raw.create_image(&info, None) }) else { return Ok(None) };
+        // SAFETY: `raw` was just created on this device; it is destroyed on the next line.
         let size = unsafe { device.raw.get_image_memory_requirements(raw) }.size;
+        // SAFETY: `raw` was never bound to memory nor used by any command, and is not used after this.
         unsafe { device.raw.destroy_image(raw, None) };
         Ok((size <= limits.max_resource_size).then_some(size))
     }
@@ -176,6 +194,11 @@ impl Image {
     /// Records copying `regions` of `buffer` into the image, which must be in
     /// TRANSFER_DST_OPTIMAL.
     pub fn copy_from_buffer(&self, cmd: vk::CommandBuffer, buffer: &Buffer, regions: &[vk::BufferImageCopy]) {
+        // SAFETY: this rests on the caller, as this safe function cannot check it: `cmd` is a command buffer
+        // of this device in the recording state (the callers pass `rec.cmd` inside `Commands::run`), the
+        // image is in TRANSFER_DST_OPTIMAL with TRANSFER_DST usage, `buffer` has TRANSFER_SRC usage, and the
+        // regions lie inside both. Both are borrowed here and kept alive by the caller until `run` has waited
+        // for the submission.
         unsafe {
             self.device.raw.cmd_copy_buffer_to_image(
                 cmd,
@@ -197,6 +220,10 @@ impl Image {
     /// Records clearing the (GENERAL layout) image to zero.
     pub fn clear(&self, cmd: vk::CommandBuffer) {
         let zero = vk::ClearColorValue { float32: [0.0; 4] };
+        // SAFETY: `cmd` is a recording command buffer of this device (the callers pass `rec.cmd`; not
+        // checked), the image is in GENERAL layout with TRANSFER_DST usage (`Image::storage` gives it), and
+        // the range covers exactly its levels and layer; the caller keeps `self` alive until `Commands::run`
+        // has waited for the submission.
         unsafe {
             self.device.raw.cmd_clear_color_image(cmd, self.raw, vk::ImageLayout::GENERAL, &zero, &[self.all_levels()])
         };
@@ -210,12 +237,19 @@ impl Image {
                 vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1),
             )
             .image_extent(vk::Extent3D { width: self.extent.width, height: self.extent.height, depth: 1 });
+        // SAFETY: as for `copy_from_buffer`, on the caller's word: `cmd` is recording on this device, the
+        // image is in `layout` with TRANSFER_SRC usage, `buffer` has TRANSFER_DST usage and room for level 0
+        // tightly packed; both stay alive until the submission has finished.
         unsafe { self.device.raw.cmd_copy_image_to_buffer(cmd, self.raw, layout, buffer.raw, &[region]) };
     }
 }
 
 impl Drop for Image {
     fn drop(&mut self) {
+        // SAFETY: the view and the image were created by `with_levels` on `self.device` and are destroyed
+        // once, here, the view before its image (a null view, left by a failed `with_levels`, is skipped); no
+        // pending submission uses them, as `Commands::run` waits before returning. The memory is freed after
+        // the image is gone, and `self.device` (a field) outlives this body.
         unsafe {
             if self.view != vk::ImageView::null() {
                 self.device.raw.destroy_image_view(self.view, None);

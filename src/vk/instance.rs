@@ -40,6 +40,9 @@ impl ValidationCounters {
 }
 
 /// A Vulkan instance that owns its debug messenger.
+// Release order: `Drop::drop` destroys the messenger and then the instance before any field drops, so `entry`
+// (the loaded library) and `counters` (the messenger's user data, also used during vkDestroyInstance) outlive
+// both.
 pub struct Instance {
     /// The loader entry points.
     pub entry: ash::Entry,
@@ -61,6 +64,9 @@ impl Instance {
 
     /// [`Instance::new`] with extra instance extensions (a window surface's).
     pub fn with_extensions(validation: bool, extra: &[*const std::ffi::c_char]) -> Result<Self, VkError> {
+        // SAFETY: loads the system Vulkan loader (libvulkan.so.1), trusting its initialisers; the returned
+        // `Entry` keeps the library loaded and is stored in `Self::entry`, which drops only after
+        // `Drop::drop` has destroyed the instance.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| VkError::Loader(e.to_string()))?;
         let app = vk::ApplicationInfo::default()
             .application_name(c"quadray")
@@ -70,6 +76,8 @@ impl Instance {
         let mut layers = Vec::new();
         let mut extensions = extra.to_vec();
         if validation {
+            // SAFETY: a global command of the entry just loaded: it takes no handles, and ash sizes the
+            // returned Vec from the count the loader reports.
             let available = unsafe { entry.enumerate_instance_layer_properties() }?;
             let found =
                 available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
@@ -78,6 +86,8 @@ impl Instance {
             }
             layers.push(VALIDATION_LAYER.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+            // SAFETY: as above; the layer name is a NUL-terminated `&'static CStr` that the loader has just
+            // listed.
             let layer_extensions = unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }?;
             let features = ash::ext::validation_features::NAME;
             if !layer_extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(features)) {
@@ -111,6 +121,12 @@ impl Instance {
             // Also report problems in vkCreateInstance / vkDestroyInstance.
             info = info.push_next(&mut messenger_info).push_next(&mut validation_features);
         }
+        // SAFETY: `info` and everything it points to (`app`, `layers`, `extensions` and, with validation, the
+        // chained `messenger_info` and `validation_features`, whose extensions are in `extensions`) are
+        // locals alive until the call returns. The names are `&'static CStr`s except those in `extra`, which
+        // must be valid NUL-terminated strings: this safe function cannot check that (the viewer passes
+        // ash-window's static names). The messenger's user data points into `counters`, which `Self` keeps
+        // past vkDestroyInstance.
         let raw = match unsafe { entry.create_instance(&info, None) } {
             Ok(raw) => raw,
             Err(e @ (vk::Result::ERROR_INCOMPATIBLE_DRIVER | vk::Result::ERROR_INITIALIZATION_FAILED)) => {
@@ -124,6 +140,10 @@ impl Instance {
 
         let debug = if validation {
             let loader = ash::ext::debug_utils::Instance::new(&entry, &raw);
+            // SAFETY: `loader` was loaded for `raw`, which enabled VK_EXT_debug_utils (pushed when
+            // `validation`); `messenger_info` is a live local whose pNext is null (push_next put it at the
+            // end of the instance's chain); its user data points into `counters`, which `Self` keeps until
+            // after `Drop::drop` destroyed the messenger.
             let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }?;
             Some((loader, messenger))
         } else {
@@ -145,6 +165,10 @@ impl Instance {
 
 impl Drop for Instance {
     fn drop(&mut self) {
+        // SAFETY: the messenger and the instance were created in `with_extensions` and are destroyed once,
+        // here (`take` leaves `None`), the messenger first since an instance's children must go before it. No
+        // device or surface is left: each holds an `Arc<Instance>`, so this runs after they dropped. `entry`
+        // and `counters` are fields and drop after this body (see the struct).
         unsafe {
             if let Some((loader, messenger)) = self.debug.take() {
                 loader.destroy_debug_utils_messenger(messenger, None);

@@ -118,6 +118,10 @@ impl PipelineResources {
             stages,
         };
         // From here on, `this` owns what is created and Drop cleans up on error.
+        // SAFETY: `raw` is the live device; the create info and `layout_bindings` (a local Vec) live until
+        // the call returns; binding numbers are distinct (keys of the interface's map) and every descriptor
+        // type is one the device supports (acceleration structures: VK_KHR_acceleration_structure is required
+        // and enabled).
         this.set_layout = unsafe {
             raw.create_descriptor_set_layout(
                 &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
@@ -130,6 +134,9 @@ impl PipelineResources {
         if push_constant_size > 0 {
             layout_info = layout_info.push_constant_ranges(&ranges);
         }
+        // SAFETY: `set_layouts` holds the set layout just created; the one push-constant range, chained only
+        // when nonzero, is at offset 0 with the stages' reflected size; all are locals alive until the call
+        // returns.
         this.layout = unsafe { raw.create_pipeline_layout(&layout_info, None) }?;
         let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
         for b in this.interface.bindings.values() {
@@ -140,12 +147,16 @@ impl PipelineResources {
             }
         }
         if !sizes.is_empty() {
+            // SAFETY: `sizes` is a local, nonempty list with one entry per descriptor type (counts summed
+            // over the bindings), alive for the call; max_sets is 1.
             this.pool = unsafe {
                 raw.create_descriptor_pool(
                     &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes),
                     None,
                 )
             }?;
+            // SAFETY: `this.pool` was just created with room for exactly one set of `set_layouts[0]`, the
+            // layout just created; no other thread has the pool.
             this.set = unsafe {
                 raw.allocate_descriptor_sets(
                     &vk::DescriptorSetAllocateInfo::default().descriptor_pool(this.pool).set_layouts(&set_layouts),
@@ -183,6 +194,10 @@ impl PipelineResources {
             InterfaceError::PushConstants { host: constants.len() as u32, shader: self.interface.push_constant_size }
         );
         let raw = &self.device.raw;
+        // SAFETY: `cmd` is a recording command buffer of this device (the callers pass `rec.cmd`; the type
+        // cannot check it); the layout and set are owned by `self` and the set was allocated with the
+        // layout's own set layout; `constants` is exactly the push-constant range (asserted above) and
+        // `self.stages` are the range's stages. The compute queue supports both bind points.
         unsafe {
             if self.set != vk::DescriptorSet::null() {
                 raw.cmd_bind_descriptor_sets(cmd, bind_point, self.layout, 0, &[self.set], &[]);
@@ -263,6 +278,12 @@ impl PipelineResources {
                 }
             }
         }
+        // SAFETY: `writes` and the arrays they point to (`buffer_infos`, `image_infos`, `as_infos` ->
+        // `as_handles`) are locals alive until the call returns; every write targets a binding the shaders
+        // declare, with the same descriptor type and count (`check_bindings`), and names live handles
+        // borrowed for this call. The set is in no pending submission (`Commands::run` waits before
+        // returning). Not checked here: callers keep the resources alive while the set is used, and do not
+        // call this while recording a command buffer that bound the set.
         unsafe { self.device.raw.update_descriptor_sets(&writes, &[]) };
         Ok(())
     }
@@ -271,6 +292,11 @@ impl PipelineResources {
 impl Drop for PipelineResources {
     fn drop(&mut self) {
         let raw = &self.device.raw;
+        // SAFETY: the pool, pipeline layout and set layout were created in `new` on `self.device` (a field,
+        // alive here) and are destroyed once, here; any still null after a failed `new` is skipped, as
+        // destroying VK_NULL_HANDLE is a no-op. Destroying the pool frees `set`. The owning pipeline's
+        // `Drop::drop` has already destroyed the pipeline, and no pending submission uses any of them
+        // (`Commands::run` waits).
         unsafe {
             raw.destroy_descriptor_pool(self.pool, None);
             raw.destroy_pipeline_layout(self.layout, None);
@@ -299,6 +325,9 @@ impl ComputePipeline {
         let (mut entries, mut values) = (Vec::new(), Vec::new());
         let spec = resources.specialization(specialization, &mut entries, &mut values)?;
         let raw = &device.raw;
+        // SAFETY: `raw` is the live device; `spirv` is a `&[u32]`, so its byte length is a multiple of 4, and
+        // `ShaderInterface::reflect` parsed it above (the words are shaderc's output, compiled at build
+        // time); the create info is a temporary alive for the call.
         let module = unsafe { raw.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(spirv), None) }?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
@@ -306,7 +335,13 @@ impl ComputePipeline {
             .name(c"main")
             .specialization_info(&spec);
         let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(resources.layout)];
+        // SAFETY: `info` -> `stage` -> `spec` -> `entries`/`values` are locals alive until the call returns;
+        // `module` is live and its entry point is `main` (a `&'static CStr`); `resources.layout` was built
+        // from this shader's reflected bindings and push constants, and the specialisation ids were checked
+        // against the shader's.
         let created = unsafe { raw.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
+        // SAFETY: a shader module may be destroyed once pipelines have been created from it; `module` was
+        // created above, never shared, and is not used after this.
         unsafe { raw.destroy_shader_module(module, None) };
         let pipeline = created.map_err(|(_, e)| e)?[0];
         Ok(Self { resources, raw: pipeline })
@@ -321,14 +356,23 @@ impl ComputePipeline {
     /// the shader's push-constant block), and a dispatch.
     pub fn dispatch(&self, cmd: vk::CommandBuffer, constants: &[u8], groups: [u32; 3]) {
         let raw = &self.resources.device.raw;
+        // SAFETY: `cmd` is a recording command buffer of this device (the callers pass `rec.cmd`; the type
+        // cannot check it); `self.raw` is a live compute pipeline owned by `self`; the queue family has
+        // compute.
         unsafe { raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw) };
         self.resources.record(cmd, vk::PipelineBindPoint::COMPUTE, constants);
+        // SAFETY: the pipeline, its descriptor set and push constants were bound just above; the resources
+        // the set names are kept alive by the caller until `Commands::run` has waited for the submission.
+        // Group counts within maxComputeWorkGroupCount are the caller's to respect (not checked).
         unsafe { raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 }
 
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
+        // SAFETY: `self.raw` was created in `new` on the resources' device and is destroyed once, here,
+        // before the `resources` field (with its layout) drops; no pending submission uses it, as
+        // `Commands::run` waits before returning.
         unsafe { self.resources.device.raw.destroy_pipeline(self.raw, None) };
     }
 }

@@ -78,9 +78,13 @@ impl RayTracingPipeline {
         let raw = &device.raw;
         let mut modules = Vec::new();
         for spirv in code {
+            // SAFETY: `raw` is the live device; each `spirv` is a `&Vec<u32>` (a byte length that is a
+            // multiple of 4) that `ShaderInterface::reflect` parsed above; the create info is a temporary
+            // alive for the call.
             match unsafe { raw.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(spirv), None) } {
                 Ok(m) => modules.push(m),
                 Err(e) => {
+                    // SAFETY: the modules created so far belong to no pipeline and are not used after this.
                     modules.iter().for_each(|&m| unsafe { raw.destroy_shader_module(m, None) });
                     return Err(e.into());
                 }
@@ -120,9 +124,17 @@ impl RayTracingPipeline {
             .groups(&groups)
             .max_pipeline_ray_recursion_depth(1)
             .layout(resources.layout)];
+        // SAFETY: `rt` was loaded for `device.raw`, which enabled VK_KHR_ray_tracing_pipeline and its
+        // rayTracingPipeline feature (`device.ray_tracing` is `Some` only then). `info` -> `stage_infos`,
+        // `groups`, `spec` -> `entries`/`values` are locals alive until the call returns; the groups name
+        // stages 0 to 3 by kind (general: ray generation and miss; procedural hit group: intersection and
+        // closest hit); recursion depth 1 is within maxRayRecursionDepth (at least 1); the layout was built
+        // from the merged interface of all four stages; no deferred operation or cache is used.
         let created = unsafe {
             rt.create_ray_tracing_pipelines(vk::DeferredOperationKHR::null(), vk::PipelineCache::null(), &info, None)
         };
+        // SAFETY: whether or not creation succeeded, no further pipeline is made from the modules; they were
+        // created above and are not used after this.
         modules.iter().for_each(|&m| unsafe { raw.destroy_shader_module(m, None) });
         let pipeline = created.map_err(|(_, e)| e)?[0];
 
@@ -132,11 +144,15 @@ impl RayTracingPipeline {
         let handle_stride = align_up(handle_size, limits.shader_group_handle_alignment);
         let region = align_up(handle_stride, limits.shader_group_base_alignment);
         let group_count = groups.len() as u32;
+        // SAFETY: `pipeline` was just created through `rt` on this device; groups 0 to `group_count` - 1
+        // exist, and the data size is `group_count` x `handle_size` bytes, as required.
         let handles = match unsafe {
             rt.get_ray_tracing_shader_group_handles(pipeline, 0, group_count, (group_count * handle_size) as usize)
         } {
             Ok(h) => h,
             Err(e) => {
+                // SAFETY: `pipeline` was created above, never recorded into a command buffer, and is not used
+                // after this.
                 unsafe { raw.destroy_pipeline(pipeline, None) };
                 return Err(e.into());
             }
@@ -147,6 +163,7 @@ impl RayTracingPipeline {
         let mut sbt = match Buffer::new(device, "shader binding table", size, usage, MemoryLocation::CpuToGpu) {
             Ok(b) => b,
             Err(e) => {
+                // SAFETY: as above: `pipeline` was never recorded and is not used after this.
                 unsafe { raw.destroy_pipeline(pipeline, None) };
                 return Err(e);
             }
@@ -179,15 +196,27 @@ impl RayTracingPipeline {
     pub fn trace(&self, cmd: vk::CommandBuffer, constants: &[u8], size: [u32; 3]) {
         let device = self.resources.device();
         let rt = &device.ray_tracing.as_ref().expect("checked in new").loader;
+        // SAFETY: `cmd` is a recording command buffer of this device (the callers pass `rec.cmd`; the type
+        // cannot check it); `self.raw` is a live ray-tracing pipeline owned by `self`; the compute queue
+        // supports the ray-tracing bind point.
         unsafe { device.raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, self.raw) };
         self.resources.record(cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, constants);
         let [raygen, miss, hit, callable] = &self.regions;
+        // SAFETY: `rt` was loaded for this device, which enabled the extension (`new` checked `ray_tracing`);
+        // the pipeline, set and push constants were bound just above. The regions lie inside `_sbt`, owned by
+        // `self` (which the caller keeps alive across `Commands::run`), in host-coherent memory written
+        // before any submission: each starts at the base alignment, the ray-generation region's stride equals
+        // its size, the other strides are multiples of the handle alignment, and the callable region is
+        // empty. A size within maxRayDispatchInvocationCount is the caller's to respect (not checked).
         unsafe { rt.cmd_trace_rays(cmd, raygen, miss, hit, callable, size[0], size[1], size[2]) };
     }
 }
 
 impl Drop for RayTracingPipeline {
     fn drop(&mut self) {
+        // SAFETY: `self.raw` was created in `new` and is destroyed once, here, before the fields drop, so
+        // `resources` (its layout and set) and `_sbt` outlive it; no pending submission uses it, as
+        // `Commands::run` waits before returning.
         unsafe { self.resources.device().raw.destroy_pipeline(self.raw, None) };
     }
 }

@@ -26,6 +26,8 @@ impl Sampler {
             .address_mode_w(vk::SamplerAddressMode::REPEAT)
             .min_lod(0.0)
             .max_lod(vk::LOD_CLAMP_NONE);
+        // SAFETY: `device.raw` is alive; `info` is a local without pNext: linear filtering, repeat
+        // addressing, no anisotropy or compare, so it needs no feature.
         let raw = unsafe { device.raw.create_sampler(&info, None) }?;
         Ok(Self { device: device.clone(), raw })
     }
@@ -33,6 +35,8 @@ impl Sampler {
 
 impl Drop for Sampler {
     fn drop(&mut self) {
+        // SAFETY: `self.raw` was created in `linear_repeat` on `self.device` (a field, so alive here) and is
+        // destroyed once, here; no pending submission uses it, as `Commands::run` waits before returning.
         unsafe { self.device.raw.destroy_sampler(self.raw, None) };
     }
 }

@@ -39,6 +39,10 @@ impl Swapchain {
     /// surface has no area (a minimised window).
     pub fn new(device: &Arc<Device>, surface: &Surface, (width, height): (u32, u32)) -> Result<Option<Self>, VkError> {
         let pd = device.physical;
+        // SAFETY: `surface.loader` was loaded for the surface's instance, which enabled VK_KHR_surface;
+        // `surface.raw` is alive (borrowed), and `pd` is `device`'s physical device, which must come from
+        // that same instance (the viewer makes the device with `Device::for_surface` on it; not checked
+        // here).
         let caps = unsafe { surface.loader.get_physical_device_surface_capabilities(pd, surface.raw) }?;
         let extent = if caps.current_extent.width != u32::MAX {
             caps.current_extent
@@ -54,6 +58,7 @@ impl Swapchain {
         if !caps.supported_usage_flags.contains(vk::ImageUsageFlags::TRANSFER_DST) {
             return Err(VkError::Vk(vk::Result::ERROR_FEATURE_NOT_PRESENT));
         }
+        // SAFETY: as above.
         let formats = unsafe { surface.loader.get_physical_device_surface_formats(pd, surface.raw) }?;
         let byte_formats = [
             vk::Format::B8G8R8A8_UNORM,
@@ -66,6 +71,7 @@ impl Swapchain {
             .find_map(|f| formats.iter().find(|s| s.format == *f))
             .copied()
             .ok_or(VkError::Vk(vk::Result::ERROR_FORMAT_NOT_SUPPORTED))?;
+        // SAFETY: as above.
         let modes = unsafe { surface.loader.get_physical_device_surface_present_modes(pd, surface.raw) }?;
         // Mailbox never blocks on a display refresh; FIFO is always there.
         let mode = if modes.contains(&vk::PresentModeKHR::MAILBOX) {
@@ -91,18 +97,30 @@ impl Swapchain {
             .present_mode(mode)
             .clipped(true);
         let loader = ash::khr::swapchain::Device::new(&device.instance.raw, &device.raw);
+        // SAFETY: `loader` was loaded for `device.raw`, which must have enabled VK_KHR_swapchain and be able
+        // to present to `surface` from its queue family: `Device::for_surface` ensures both; nothing here
+        // checks it for a device from `Device::new`. `info` is a local without pNext: a format and colour
+        // space the surface reports, extent and image count within its limits, TRANSFER_DST usage (checked
+        // above), FIFO or a reported present mode, the current transform. OPAQUE composite alpha is assumed,
+        // not checked against `supported_composite_alpha`.
         let raw = unsafe { loader.create_swapchain(&info, None) }?;
+        // SAFETY: `raw` was just created by `loader` and is alive.
         let images = match unsafe { loader.get_swapchain_images(raw) } {
             Ok(i) => i,
             Err(e) => {
+                // SAFETY: `raw` was created above, no image of it was acquired, and it is not used after
+                // this.
                 unsafe { loader.destroy_swapchain(raw, None) };
                 return Err(e.into());
             }
         };
+        // SAFETY: `device.raw` is alive; the create info is a default one (unsignalled, no pNext), alive for
+        // the call.
         let acquired = unsafe { device.raw.create_fence(&vk::FenceCreateInfo::default(), None) };
         let acquired = match acquired {
             Ok(f) => f,
             Err(e) => {
+                // SAFETY: as above: no image of `raw` was acquired, and it is not used after this.
                 unsafe { loader.destroy_swapchain(raw, None) };
                 return Err(e.into());
             }
@@ -117,6 +135,8 @@ impl Swapchain {
         let staging = match staging {
             Ok(b) => b,
             Err(e) => {
+                // SAFETY: the fence and the swapchain were created above, never waited on or acquired from,
+                // and are not used after this.
                 unsafe {
                     device.raw.destroy_fence(acquired, None);
                     loader.destroy_swapchain(raw, None);
@@ -140,6 +160,10 @@ impl Swapchain {
     pub fn present(&mut self, cmds: &mut Commands, rgba: &[u8]) -> Result<PresentResult, VkError> {
         let (w, h) = (self.extent.width as usize, self.extent.height as usize);
         assert_eq!(rgba.len(), w * h * 4, "frame size does not match the swapchain");
+        // SAFETY: `self.raw` is owned by `self` and alive; `self.acquired` is unsignalled (created so,
+        // and reset after every wait below) and in use by nothing else; a fence without a semaphore is
+        // allowed. On success each acquired image is presented below before the next acquire, so at most
+        // one is held and the infinite timeout cannot wait forever.
         let acquire =
             unsafe { self.loader.acquire_next_image(self.raw, u64::MAX, vk::Semaphore::null(), self.acquired) };
         let index = match acquire {
@@ -147,6 +171,8 @@ impl Swapchain {
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => return Ok(PresentResult::OutOfDate),
             Err(e) => return Err(e.into()),
         };
+        // SAFETY: `self.acquired` is the live fence just given to the successful acquire; once waited for it
+        // is in use by nothing, so it may be reset, leaving it unsignalled for the next acquire.
         unsafe {
             self.device.raw.wait_for_fences(&[self.acquired], true, u64::MAX)?;
             self.device.raw.reset_fences(&[self.acquired])?;
@@ -205,6 +231,11 @@ impl Swapchain {
         let swapchains = [self.raw];
         let indices = [index];
         let info = vk::PresentInfoKHR::default().swapchains(&swapchains).image_indices(&indices);
+        // SAFETY: `self.device.queue` is from a family that can present to this surface
+        // (`Device::for_surface` checked it); image `index` was acquired above and moved to PRESENT_SRC_KHR
+        // by the submission that `Commands::run` waited for, so no semaphore is needed; `info` ->
+        // `swapchains`, `indices` are locals alive for the call. As for every submission here, no other
+        // thread may use the queue meanwhile (nothing locks it).
         match unsafe { self.loader.queue_present(self.device.queue, &info) } {
             Ok(false) => Ok(PresentResult::Presented),
             Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => Ok(PresentResult::OutOfDate),
@@ -215,6 +246,9 @@ impl Swapchain {
 
 impl Drop for Swapchain {
     fn drop(&mut self) {
+        // SAFETY: after device_wait_idle nothing uses the fence or the swapchain's images; both were created
+        // in `new` on `self.device` (a field, alive here) and are destroyed once, here. The surface is still
+        // alive: its owner drops it after the swapchain (see `Surface`'s Drop).
         unsafe {
             let _ = self.device.raw.device_wait_idle();
             self.device.raw.destroy_fence(self.acquired, None);

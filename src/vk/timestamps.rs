@@ -17,23 +17,37 @@ impl Timestamps {
     /// A pool of `count` timestamps.
     pub fn new(device: &Arc<Device>, count: u32) -> Result<Self, VkError> {
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(count);
+        // SAFETY: `device.raw` is alive; `info` is a local without pNext for timestamp queries, which need no
+        // feature. `count` must be nonzero: the caller's (GpuTimer and the probe pass ask for 2), not checked
+        // here.
         let pool = unsafe { device.raw.create_query_pool(&info, None) }?;
         Ok(Self { device: device.clone(), pool, count })
     }
 
     /// Records a reset of every query (outside a render pass).
     pub fn reset(&self, cmd: vk::CommandBuffer) {
+        // SAFETY: `cmd` is a recording command buffer of this device (the callers pass `rec.cmd`; the type
+        // cannot check it), outside any render pass (the renderer uses none); queries 0 to `count` - 1 are
+        // exactly the pool's.
         unsafe { self.device.raw.cmd_reset_query_pool(cmd, self.pool, 0, self.count) };
     }
 
     /// Records timestamp `index` after all previous work has finished.
     pub fn write(&self, cmd: vk::CommandBuffer, index: u32) {
+        // SAFETY: `cmd` as for `reset`, on a queue family with timestampValidBits > 0 (`GpuTimer::new` checks
+        // this; other callers must); the caller has reset the pool earlier in the command buffer and passes
+        // `index` < `count` (not checked here).
         unsafe { self.device.raw.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, index) };
     }
 
     /// Reads all timestamps (waiting for them) in nanoseconds.
     pub fn read_ns(&self) -> Result<Vec<f64>, VkError> {
         let mut ticks = vec![0u64; self.count as usize];
+        // SAFETY: `self.pool` is live and owned by `self`; `ticks` holds `count` u64 values, which matches
+        // TYPE_64 and the 8-byte stride ash passes. With WAIT the call blocks until the queries are
+        // available, so every query must have been reset and written by a submitted command buffer: callers
+        // read after `Commands::run` has waited for one that did (GpuTimer::run, the probe pass), which this
+        // function cannot check.
         unsafe {
             self.device.raw.get_query_pool_results(
                 self.pool,
@@ -49,6 +63,8 @@ impl Timestamps {
 
 impl Drop for Timestamps {
     fn drop(&mut self) {
+        // SAFETY: `self.pool` was created in `new` on `self.device` (a field, alive here) and is destroyed
+        // once, here; no pending submission uses it, as `Commands::run` waits before returning.
         unsafe { self.device.raw.destroy_query_pool(self.pool, None) };
     }
 }
@@ -63,6 +79,7 @@ pub struct GpuTimer {
 impl GpuTimer {
     /// A timer on `device`'s queue.
     pub fn new(device: &Arc<Device>) -> Result<Self, VkError> {
+        // SAFETY: `device.physical` is the physical device of `device.raw`, from the live `device.instance`.
         let families = unsafe { device.instance.raw.get_physical_device_queue_family_properties(device.physical) };
         let valid_bits = families.get(device.queue_family as usize).map_or(0, |f| f.timestamp_valid_bits);
         let stamps = if valid_bits > 0 { Some(Timestamps::new(device, 2)?) } else { None };
