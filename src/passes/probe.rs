@@ -52,7 +52,10 @@ impl ProbePass {
         curvature: bool,
         backend: Backend,
     ) -> Result<Self, RenderError> {
-        let [budget, far] = scene.scene_constants();
+        let [budget, (far_id, far)] = scene.scene_constants();
+        // The given rays may start anywhere: farther than the scene's own.
+        let reach = rays.iter().map(|r| glam::Vec3::from(r.origin).length() as f64).fold(0.0, f64::max);
+        let far = (far_id, far.max(u32::from(reach > scene.near_reach())));
         let spec = [(SPEC_INTERSECT_MODE, mode.constant()), (SPEC_PROBE_CURVATURE, u32::from(curvature)), budget, far];
         let tracer = Tracer::new(device, backend, shaders::probe, shaders::probe_rgen, &spec)?;
         let rays_buf = Buffer::with_data(device, "probe rays", rays, vk::BufferUsageFlags::STORAGE_BUFFER)?;

@@ -77,6 +77,9 @@ pub struct GpuScene {
     /// Whether a ray can start beyond an object's rebase distance
     /// ([`Self::far_rays`]).
     far_rays: bool,
+    /// How far from the frame's origin rays may start without the far-ray
+    /// search ([`Self::near_reach`]).
+    near_reach: f64,
 }
 
 /// Loop back-edges Mesa 25.0's gallivm source allows one shader invocation
@@ -241,8 +244,10 @@ fn f32_box(b: &Aabb) -> ([f32; 3], [f32; 3]) {
 /// light's start on a plane 2 radii + 1 beyond the specular objects'
 /// bounding sphere, `caustics::parallel_grid`: within 3 reaches + 1).
 fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
-    // An animated camera's rays start at each keyframe's position.
-    let camera = scene.camera.keyframes.iter().map(|k| (k.position - origin).length()).fold(0.0, f64::max);
+    // Camera rays start at the camera (at the origin in renders) and at each
+    // keyframe's position of an animated camera.
+    let keyframes = scene.camera.keyframes.iter().map(|k| (k.position - origin).length());
+    let camera = keyframes.fold((scene.camera.position - origin).length(), f64::max);
     let objects = scene
         .objects
         .iter()
@@ -265,23 +270,23 @@ fn scene_reach(scene: &Scene, origin: DVec3) -> f64 {
     lights.fold(objects.max(camera), f64::max)
 }
 
-/// Whether a ray starting within `reach` of the GPU frame's origin can start
-/// beyond the object's rebase distance in its own frame (`to_world` maps
-/// the object's frame to the GPU's): the object-frame origin of a world
-/// point x is L⁻¹(x - t), at most ‖L⁻¹‖₂ (|x| + |t|) from the object's
-/// origin. 90 % of the rebase distance is the threshold, a margin over the
-/// f32 rounding of the hardware's object ray (a ray just beyond the rebase
-/// distance is as well served by the near search as one just within it:
-/// the distance is a choice, not a cliff).
-fn far_rays_possible(to_world: &DAffine3, rebase_distance: f64, reach: f64) -> bool {
-    stretch_bound(&to_world.matrix3.inverse()) * (reach + to_world.translation.length()) > 0.9 * rebase_distance
+/// How far from the GPU frame's origin a ray may start and still be near
+/// the object (within 90 % of its rebase distance in its own frame;
+/// `to_world` maps the object's frame to the GPU's): the object-frame origin
+/// of a world point x is L⁻¹(x - t), at most ‖L⁻¹‖₂ (|x| + |t|) from the
+/// object's origin. The 10 % are a margin over the f32 rounding of the
+/// hardware's object ray (a ray just beyond the rebase distance is as well
+/// served by the near search as one just within it: the distance is a
+/// choice, not a cliff).
+fn near_limit(to_world: &DAffine3, rebase_distance: f64) -> f64 {
+    0.9 * rebase_distance / stretch_bound(&to_world.matrix3.inverse()) - to_world.translation.length()
 }
 
 /// An upper bound on how far `m` stretches a vector (its spectral norm):
 /// the square root of the largest absolute row sum of mᵀm, which bounds
 /// that matrix's largest eigenvalue (Gershgorin). Exact for rotations and
 /// scalings; within 3^¼ of the norm otherwise (the Frobenius norm is within
-/// √3, too loose for [`far_rays_possible`]).
+/// √3, too loose for [`near_limit`]).
 fn stretch_bound(m: &DMat3) -> f64 {
     let s = m.transpose() * *m;
     let rows = (0..3).map(|i| (0..3).map(|j| s.col(j)[i].abs()).sum::<f64>());
@@ -369,7 +374,7 @@ impl GpuScene {
         let mut blases = Vec::new();
         let mut placements = Vec::new();
         let reach = scene_reach(scene, origin);
-        let mut far_rays = std::env::var_os("QUADRAY_FORCE_FAR").is_some();
+        let mut near_reach = f64::INFINITY;
 
         for (index, object) in scene.objects.iter().enumerate() {
             let object_cells = object
@@ -381,7 +386,7 @@ impl GpuScene {
             let first_cell = cells.len() as u32;
             let relative = DAffine3::from_translation(-origin) * object.transform;
             objects.push(GpuObject::new(object, first_cell, &relative));
-            far_rays |= far_rays_possible(&relative, GpuObject::rebase_distance(object), reach);
+            near_reach = near_reach.min(near_limit(&relative, GpuObject::rebase_distance(object)));
             if object_cells.is_empty() {
                 continue;
             }
@@ -472,7 +477,8 @@ impl GpuScene {
             origin,
             loop_budget: loop_budget_buffer(device)?,
             measure_loop_budget: false,
-            far_rays,
+            far_rays: reach > near_reach,
+            near_reach,
         })
     }
 
@@ -490,6 +496,14 @@ impl GpuScene {
     /// scene's reach: for a camera that may go anywhere (the viewer).
     pub fn allow_far_rays(&mut self) {
         self.far_rays = true;
+    }
+
+    /// How far from the GPU frame's origin a ray may start and still be near
+    /// every object: a pass whose rays start farther (a probe pass's given
+    /// rays) needs the far-ray search even where the scene's own rays do
+    /// not ([`Self::far_rays`]).
+    pub fn near_reach(&self) -> f64 {
+        self.near_reach
     }
 
     /// Turns the loop-budget measurement on or off for the passes built
