@@ -197,31 +197,6 @@ vec2 roughDielectricEvalPdf(Material mat, vec3 wo, vec3 wi) {
     return vec2(value, pdf);
 }
 
-// f(wo, wi) (without the cosine) for non-delta lobes.
-vec3 bsdfEval(Material mat, vec3 wo, vec3 wi) {
-    if (isRoughDielectric(mat)) return vec3(roughDielectricEvalPdf(mat, wo, wi).x);
-    if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
-    if (mat.kind == MATERIAL_DIFFUSE) return v3(mat.albedo) / PI;
-    if (mat.kind == MATERIAL_CONDUCTOR) {
-        float a = materialAlpha(mat);
-        vec3 m = normalize(wo + wi);
-        return conductorFresnel(mat, dot(wo, m)) * (ggxD(m, a) * ggxG2(wo, wi, a) / (4.0 * wo.z * wi.z));
-    }
-    return vec3(0.0);
-}
-
-// Solid-angle density of bsdfSample choosing wi (non-delta lobes).
-float bsdfPdf(Material mat, vec3 wo, vec3 wi) {
-    if (isRoughDielectric(mat)) return roughDielectricEvalPdf(mat, wo, wi).y;
-    if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
-    if (mat.kind == MATERIAL_DIFFUSE) return wi.z / PI;
-    if (mat.kind == MATERIAL_CONDUCTOR) {
-        vec3 m = normalize(wo + wi);
-        return ggxVisiblePdf(wo, m, materialAlpha(mat)) / (4.0 * dot(wo, m));
-    }
-    return 0.0;
-}
-
 struct BsdfSample {
     vec3 wi;
     vec3 weight;   // f |cos θi| / pdf
@@ -229,90 +204,155 @@ struct BsdfSample {
     bool valid;
 };
 
-BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
-    BsdfSample s;
-    s.valid = false;
-    s.pdf = 0.0;
-    s.weight = vec3(0.0);
-    s.wi = vec3(0.0, 0.0, 1.0);
-    if (isRoughDielectric(mat)) {
-        if (wo.z == 0.0) return s;
-        float sgn = wo.z > 0.0 ? 1.0 : -1.0;
-        vec3 o = vec3(wo.xy, abs(wo.z));
-        float eta = sgn > 0.0 ? mat.ior : 1.0 / mat.ior;
-        float a = materialAlpha(mat);
-        vec3 m = ggxSampleVisibleNormal(o, a, u.xy);
-        float c = dot(o, m);
-        if (c <= 0.0) return s;
-        float f = fresnelDielectric(c, eta);
-        vec3 i;
-        if (u.z < f) {
-            i = 2.0 * c * m - o;
-            if (i.z <= 0.0) return s;
-            s.pdf = f * ggxVisiblePdf(o, m, a) / (4.0 * c);
-            s.weight = vec3(ggxG2OverG1(o, i, a));
-        } else {
-            float sin2T = (1.0 - c * c) / (eta * eta);
-            if (sin2T >= 1.0) return s;
-            float cosT = sqrt(1.0 - sin2T);
-            i = -o / eta + (c / eta - cosT) * m;
-            if (i.z >= 0.0) return s;
-            float den = c - eta * cosT;
-            s.pdf = (1.0 - f) * ggxVisiblePdf(o, m, a) * eta * eta * cosT / (den * den);
-            s.weight = vec3(ggxG2OverG1(o, i, a) / (eta * eta));
-        }
-        s.wi = vec3(i.xy, sgn * i.z);
-        s.valid = s.pdf > 0.0 && !isinf(s.pdf) && !isnan(s.pdf);
-        return s;
+// No sample (valid false): what a lobe returns where it cannot sample.
+BsdfSample noSample() { return BsdfSample(vec3(0.0, 0.0, 1.0), vec3(0.0), 0.0, false); }
+
+// One function per lobe and per operation (evaluation, pdf, sampling), as the
+// f64 twins in src/sampling/bsdf.rs have one type per lobe; bsdfEval,
+// bsdfPdf and bsdfSample below pick the material's lobe.
+
+// ---- Rough dielectric, sampling (f and pdf: roughDielectricEvalPdf above) ----
+BsdfSample roughDielectricSample(Material mat, vec3 wo, vec3 u) {
+    BsdfSample s = noSample();
+    if (wo.z == 0.0) return s;
+    float sgn = wo.z > 0.0 ? 1.0 : -1.0;
+    vec3 o = vec3(wo.xy, abs(wo.z));
+    float eta = sgn > 0.0 ? mat.ior : 1.0 / mat.ior;
+    float a = materialAlpha(mat);
+    vec3 m = ggxSampleVisibleNormal(o, a, u.xy);
+    float c = dot(o, m);
+    if (c <= 0.0) return s;
+    float f = fresnelDielectric(c, eta);
+    vec3 i;
+    if (u.z < f) {
+        i = 2.0 * c * m - o;
+        if (i.z <= 0.0) return s;
+        s.pdf = f * ggxVisiblePdf(o, m, a) / (4.0 * c);
+        s.weight = vec3(ggxG2OverG1(o, i, a));
+    } else {
+        float sin2T = (1.0 - c * c) / (eta * eta);
+        if (sin2T >= 1.0) return s;
+        float cosT = sqrt(1.0 - sin2T);
+        i = -o / eta + (c / eta - cosT) * m;
+        if (i.z >= 0.0) return s;
+        float den = c - eta * cosT;
+        s.pdf = (1.0 - f) * ggxVisiblePdf(o, m, a) * eta * eta * cosT / (den * den);
+        s.weight = vec3(ggxG2OverG1(o, i, a) / (eta * eta));
     }
-    if (mat.kind == MATERIAL_DIELECTRIC) {
-        // Smooth dielectric.
-        if (wo.z == 0.0) return s;
-        float f = fresnelDielectric(wo.z, mat.ior);
-        if (u.z < f) {
-            s.wi = vec3(-wo.x, -wo.y, wo.z);
-            s.weight = vec3(1.0);
-        } else {
-            float etaRel = wo.z > 0.0 ? mat.ior : 1.0 / mat.ior;  // n_t / n_i
-            float cosI = abs(wo.z);
-            float cosT = sqrt(max(0.0, 1.0 - (1.0 - cosI * cosI) / (etaRel * etaRel)));
-            float side = wo.z > 0.0 ? 1.0 : -1.0;
-            s.wi = normalize(-wo / etaRel + (cosI / etaRel - cosT) * vec3(0.0, 0.0, side));
-            s.weight = vec3(1.0 / (etaRel * etaRel));
-        }
-        s.valid = true;
-        return s;
-    }
-    if (wo.z <= 0.0) return s;
-    if (mat.kind == MATERIAL_MIRROR) {
+    s.wi = vec3(i.xy, sgn * i.z);
+    s.valid = s.pdf > 0.0 && !isinf(s.pdf) && !isnan(s.pdf);
+    return s;
+}
+
+// ---- Smooth dielectric (sampling::SmoothDielectric): a delta lobe ------------
+BsdfSample smoothDielectricSample(Material mat, vec3 wo, vec3 u) {
+    BsdfSample s = noSample();
+    if (wo.z == 0.0) return s;
+    float f = fresnelDielectric(wo.z, mat.ior);
+    if (u.z < f) {
         s.wi = vec3(-wo.x, -wo.y, wo.z);
-        s.weight = v3(mat.albedo);
+        s.weight = vec3(1.0);
+    } else {
+        float etaRel = wo.z > 0.0 ? mat.ior : 1.0 / mat.ior;  // n_t / n_i
+        float cosI = abs(wo.z);
+        float cosT = sqrt(max(0.0, 1.0 - (1.0 - cosI * cosI) / (etaRel * etaRel)));
+        float side = wo.z > 0.0 ? 1.0 : -1.0;
+        s.wi = normalize(-wo / etaRel + (cosI / etaRel - cosT) * vec3(0.0, 0.0, side));
+        s.weight = vec3(1.0 / (etaRel * etaRel));
+    }
+    s.valid = true;
+    return s;
+}
+
+// ---- Mirror (sampling::Mirror): a delta lobe ---------------------------------
+BsdfSample mirrorSample(Material mat, vec3 wo) {
+    BsdfSample s = noSample();
+    if (wo.z <= 0.0) return s;
+    s.wi = vec3(-wo.x, -wo.y, wo.z);
+    s.weight = v3(mat.albedo);
+    s.valid = true;
+    return s;
+}
+
+// ---- Conductor (sampling::Conductor): GGX, a delta lobe below ALPHA_DELTA ----
+vec3 conductorEval(Material mat, vec3 wo, vec3 wi) {
+    if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
+    float a = materialAlpha(mat);
+    vec3 m = normalize(wo + wi);
+    return conductorFresnel(mat, dot(wo, m)) * (ggxD(m, a) * ggxG2(wo, wi, a) / (4.0 * wo.z * wi.z));
+}
+
+float conductorPdf(Material mat, vec3 wo, vec3 wi) {
+    if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
+    vec3 m = normalize(wo + wi);
+    return ggxVisiblePdf(wo, m, materialAlpha(mat)) / (4.0 * dot(wo, m));
+}
+
+BsdfSample conductorSample(Material mat, vec3 wo, vec3 u) {
+    BsdfSample s = noSample();
+    if (wo.z <= 0.0) return s;
+    float a = materialAlpha(mat);
+    if (a < ALPHA_DELTA) {
+        s.wi = vec3(-wo.x, -wo.y, wo.z);
+        s.weight = conductorFresnel(mat, wo.z);
         s.valid = true;
         return s;
     }
-    if (mat.kind == MATERIAL_CONDUCTOR) {
-        float a = materialAlpha(mat);
-        if (a < ALPHA_DELTA) {
-            s.wi = vec3(-wo.x, -wo.y, wo.z);
-            s.weight = conductorFresnel(mat, wo.z);
-            s.valid = true;
-            return s;
-        }
-        vec3 m = ggxSampleVisibleNormal(wo, a, u.xy);
-        float om = dot(wo, m);
-        s.wi = 2.0 * om * m - wo;
-        if (s.wi.z <= 0.0 || om <= 0.0) return s;
-        s.pdf = ggxVisiblePdf(wo, m, a) / (4.0 * om);
-        s.weight = conductorFresnel(mat, om) * ggxG2OverG1(wo, s.wi, a);
-        s.valid = s.pdf > 0.0;
-        return s;
-    }
-    // Diffuse.
+    vec3 m = ggxSampleVisibleNormal(wo, a, u.xy);
+    float om = dot(wo, m);
+    s.wi = 2.0 * om * m - wo;
+    if (s.wi.z <= 0.0 || om <= 0.0) return s;
+    s.pdf = ggxVisiblePdf(wo, m, a) / (4.0 * om);
+    s.weight = conductorFresnel(mat, om) * ggxG2OverG1(wo, s.wi, a);
+    s.valid = s.pdf > 0.0;
+    return s;
+}
+
+// ---- Diffuse (sampling::Diffuse): Lambert, cosine-weighted sampling ----------
+vec3 diffuseEval(Material mat, vec3 wo, vec3 wi) {
+    if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
+    return v3(mat.albedo) / PI;
+}
+
+float diffusePdf(vec3 wo, vec3 wi) {
+    if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
+    return wi.z / PI;
+}
+
+BsdfSample diffuseSample(Material mat, vec3 wo, vec3 u) {
+    BsdfSample s = noSample();
+    if (wo.z <= 0.0) return s;
     s.wi = sampleCosineHemisphere(u.xy);
     s.pdf = s.wi.z / PI;
     s.weight = v3(mat.albedo);
     s.valid = s.pdf > 0.0;
     return s;
+}
+
+// ---- The material's lobe -----------------------------------------------------
+// f(wo, wi) (without the cosine) for non-delta lobes.
+vec3 bsdfEval(Material mat, vec3 wo, vec3 wi) {
+    if (isRoughDielectric(mat)) return vec3(roughDielectricEvalPdf(mat, wo, wi).x);
+    if (mat.kind == MATERIAL_DIFFUSE) return diffuseEval(mat, wo, wi);
+    if (mat.kind == MATERIAL_CONDUCTOR) return conductorEval(mat, wo, wi);
+    return vec3(0.0);
+}
+
+// Solid-angle density of bsdfSample choosing wi (non-delta lobes).
+float bsdfPdf(Material mat, vec3 wo, vec3 wi) {
+    if (isRoughDielectric(mat)) return roughDielectricEvalPdf(mat, wo, wi).y;
+    if (mat.kind == MATERIAL_DIFFUSE) return diffusePdf(wo, wi);
+    if (mat.kind == MATERIAL_CONDUCTOR) return conductorPdf(mat, wo, wi);
+    return 0.0;
+}
+
+// A direction wi for wo from the material's lobe, with its weight and pdf.
+BsdfSample bsdfSample(Material mat, vec3 wo, vec3 u) {
+    if (isRoughDielectric(mat)) return roughDielectricSample(mat, wo, u);
+    if (mat.kind == MATERIAL_DIELECTRIC) return smoothDielectricSample(mat, wo, u);
+    if (mat.kind == MATERIAL_MIRROR) return mirrorSample(mat, wo);
+    if (mat.kind == MATERIAL_CONDUCTOR) return conductorSample(mat, wo, u);
+    return diffuseSample(mat, wo, u);
 }
 
 #endif
