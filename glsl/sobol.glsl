@@ -1,4 +1,4 @@
-// The path tracer's samples: Owen-scrambled Sobol points (Burley 2020,
+// Owen-scrambled Sobol points (Burley 2020,
 // "Practical Hash-based Owen Scrambling", JCGT 9(4); as Cycles'
 // sobol-burley and pbrt-v4's ZSobolSampler use them), one dimension pair
 // per decision along the path.
@@ -16,14 +16,14 @@
 
 #include "random.glsl"
 
-struct PathSampler {
+struct SobolSampler {
     uint seed;       // the pixel's scrambling seed
     uint index;      // the sample's index in the pixel's sequence
     uint dimension;  // the next decision's dimension pair
 };
 
-PathSampler pathSampler(uvec2 pixel, uint sampleIndex, uint seed) {
-    return PathSampler(pcgHash(pixel.x ^ pcgHash(pixel.y ^ pcgHash(seed ^ 0x68bc21ebu))), sampleIndex, 0u);
+SobolSampler sobolSampler(uvec2 pixel, uint sampleIndex, uint seed) {
+    return SobolSampler(pcgHash(pixel.x ^ pcgHash(pixel.y ^ pcgHash(seed ^ 0x68bc21ebu))), sampleIndex, 0u);
 }
 
 // Laine and Karras' hash-based Owen scramble of bit-reversed `x` (Burley,
@@ -54,7 +54,7 @@ uint sobolSecond(uint index) {
 }
 
 // The next decision's 2D point in [0, 1)².
-vec2 sample2(inout PathSampler s) {
+vec2 sobolSample2(inout SobolSampler s) {
     uint seed = pcgHash(s.seed ^ pcgHash(s.dimension));
     ++s.dimension;
     uint i = owenScramble(s.index, seed);
@@ -64,7 +64,25 @@ vec2 sample2(inout PathSampler s) {
     return vec2(float(x >> 8), float(y >> 8)) * (1.0 / 16777216.0);
 }
 
-// The next decision's number in [0, 1): the first coordinate of its pair.
-float sample1(inout PathSampler s) { return sample2(s).x; }
+// The path tracer's samples (render.glsl): SAMPLER_SOBOL takes each
+// decision's numbers from the Sobol points above, SAMPLER_INDEPENDENT from
+// one random generator per pixel and sample (random.glsl), drawn in the
+// order of the path's decisions (src/passes/variant.rs, SamplerMode).
+layout(constant_id = SPEC_SAMPLER) const uint SAMPLER = SAMPLER_SOBOL;
+
+struct PathSampler {
+    uint rng;
+    SobolSampler sobol;
+};
+
+PathSampler pathSampler(uvec2 pixel, uint sampleIndex, uint seed) {
+    if (SAMPLER == SAMPLER_SOBOL) return PathSampler(0u, sobolSampler(pixel, sampleIndex, seed));
+    return PathSampler(seedRandom(pixel, sampleIndex, seed), SobolSampler(0u, 0u, 0u));
+}
+
+vec2 sample2(inout PathSampler s) { return SAMPLER == SAMPLER_SOBOL ? sobolSample2(s.sobol) : rand2(s.rng); }
+
+// A 1D decision: the first coordinate of a Sobol pair, or one random number.
+float sample1(inout PathSampler s) { return SAMPLER == SAMPLER_SOBOL ? sobolSample2(s.sobol).x : rand(s.rng); }
 
 #endif

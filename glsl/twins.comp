@@ -62,8 +62,8 @@ void main() {
     r.pdfOf = 0.0;
     r.dist = 0.0;
     if (c.op == OP_SOBOL) {
-        PathSampler s = PathSampler(floatBitsToUint(c.u[0]), uint(c.u[1]), uint(c.u[2]));
-        vec2 p = sample2(s);
+        SobolSampler s = SobolSampler(floatBitsToUint(c.u[0]), uint(c.u[1]), uint(c.u[2]));
+        vec2 p = sobolSample2(s);
         r.wi = float[3](p.x, p.y, float(s.dimension));
         r.weight = f3(vec3(0.0));
         r.pdf = 0.0;

@@ -182,6 +182,13 @@ pub const SPEC_LOOP_BUDGET: u32 = 10;
 /// far-ray search (glsl/root_search.glsl, candidateFirstRoot) and its
 /// per-candidate test out of the shaders; 1 (the default) keeps them.
 pub const SPEC_FAR_RAYS: u32 = 11;
+/// Specialisation constant id: the path tracer's samples (SAMPLER_*).
+pub const SPEC_SAMPLER: u32 = 12;
+/// Sampler: independent random numbers per decision (glsl/random.glsl).
+pub const SAMPLER_INDEPENDENT: u32 = 0;
+/// Sampler: Owen-scrambled Sobol points, one dimension pair per decision
+/// (glsl/sobol.glsl).
+pub const SAMPLER_SOBOL: u32 = 1;
 /// Vertices a recorded path holds at most.
 pub const PATH_RECORD_VERTICES: u32 = 96;
 /// Recorded path event: a surface scattering (a BSDF sample).

@@ -51,6 +51,13 @@ pub(crate) struct RenderArgs {
     /// and volume passes alike). The images agree to float rounding.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto, env = "QUADRAY_BACKEND")]
     pub(crate) backend: BackendChoice,
+    /// The path tracer's samples: `sobol` (Owen-scrambled Sobol points, one
+    /// dimension pair per decision along the path; lower error at equal
+    /// spp) or `independent` (independent random numbers, whose per-pixel
+    /// errors are plain Monte Carlo noise). Both are unbiased; the camera
+    /// jitter is the same stratified sequence in both.
+    #[arg(long, value_enum, default_value_t = SamplerChoice::Sobol)]
+    pub(crate) sampler: SamplerChoice,
     /// Write checkpoints of the work so far to this file (atomically), every
     /// --checkpoint-every seconds and when the render is stopped by SIGINT,
     /// SIGTERM or --time-limit; removed once the render completes and its
@@ -160,6 +167,7 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
     let variant = quadray::passes::RenderVariant {
         caustics: !args.brute_force,
         volume: !args.brute_force,
+        sampler: args.sampler.mode(),
         backend: Some(backend),
         ..Default::default()
     };

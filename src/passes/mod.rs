@@ -22,5 +22,5 @@ pub use render::{render, RecordedPath, Renderer};
 pub use scene_gpu::{GeometryStats, GpuScene, LoopBudget, LOOP_LIMIT};
 pub use texprobe::TexProbePass;
 pub use tracer::Tracer;
-pub use variant::{IntersectMode, LookupMode, RenderVariant, ShadingMode};
+pub use variant::{IntersectMode, LookupMode, RenderVariant, SamplerMode, ShadingMode};
 pub use volume::VolumeLight;

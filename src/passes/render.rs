@@ -16,7 +16,7 @@ use crate::shader_interface::{
     BINDING_ACCUM, BINDING_AOV, BINDING_ENV_CDF, BINDING_RENDER_BEAMS, BINDING_RENDER_CAUSTICS, BINDING_RENDER_GBUFFER,
     BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, BINDING_RENDER_VOLUME, NO_TEXTURE, PATH_RECORD_VERTICES,
     RENDER_GROUP, SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED, SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE,
-    SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
+    SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SAMPLER, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
 };
 use crate::vk::{vk, Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation, ShaderStage};
 use crate::{shaders, RenderError};
@@ -642,6 +642,7 @@ fn render_pipeline(
             (SPEC_BEAMS_ENABLED, u32::from(caustics.is_some_and(|c| c.has_beams))),
             (SPEC_RECORD_PATH, u32::from(variant.record_path)),
             (SPEC_LOOKUP_MODE, variant.lookup.constant()),
+            (SPEC_SAMPLER, variant.sampler.constant()),
         ],
     )?)
 }

@@ -5,8 +5,8 @@
 //! every render entry point takes it from there.
 
 use crate::shader_interface::{
-    INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, LOOKUP_EWA, LOOKUP_PROBES, SHADING_FULL, SHADING_GLOSSY_ALBEDO,
-    SHADING_MIRRORED_ALBEDO, SHADING_NONE,
+    INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, LOOKUP_EWA, LOOKUP_PROBES, SAMPLER_INDEPENDENT, SAMPLER_SOBOL,
+    SHADING_FULL, SHADING_GLOSSY_ALBEDO, SHADING_MIRRORED_ALBEDO, SHADING_NONE,
 };
 use crate::vk::Backend;
 
@@ -83,6 +83,30 @@ impl LookupMode {
     }
 }
 
+/// Where the path tracer's random decisions take their numbers
+/// (`SPEC_SAMPLER`; glsl/sobol.glsl). The camera jitter keeps its own
+/// stratified sequence in both.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SamplerMode {
+    /// Owen-scrambled Sobol points (Burley 2020), one dimension pair per
+    /// decision along the path (the renderer's sampler).
+    #[default]
+    Sobol,
+    /// Independent uniform random numbers (the reference for the error's
+    /// distribution: its per-pixel errors are plain Monte Carlo noise).
+    Independent,
+}
+
+impl SamplerMode {
+    /// The `SAMPLER_*` value the render shader is specialised with.
+    pub fn constant(self) -> u32 {
+        match self {
+            Self::Sobol => SAMPLER_SOBOL,
+            Self::Independent => SAMPLER_INDEPENDENT,
+        }
+    }
+}
+
 /// Variants of the render shader that switch parts of the work off, to
 /// measure what bounds a render (the benchmark mode) or to test parts of it.
 /// `Default` renders.
@@ -104,6 +128,8 @@ pub struct RenderVariant {
     pub record_path: bool,
     /// The filtered modes' texture lookup.
     pub lookup: LookupMode,
+    /// The path tracer's samples.
+    pub sampler: SamplerMode,
     /// How every tracing pass (render, caustic G-buffer and rays, volume)
     /// traces rays: ray queries, or a ray-tracing pipeline with the
     /// intersection shader. `None` takes the device's preferred one
@@ -122,6 +148,7 @@ impl Default for RenderVariant {
             volume: true,
             record_path: false,
             lookup: LookupMode::Probes,
+            sampler: SamplerMode::Sobol,
             backend: None,
         }
     }

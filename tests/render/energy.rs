@@ -10,7 +10,7 @@ use crate::common;
 
 use quadray::passes::outliers::{describe_path, largest_sample, luminance, outliers, SampleBound};
 use quadray::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
-use quadray::passes::{IntersectMode, LookupMode, ShadingMode};
+use quadray::passes::{IntersectMode, LookupMode, SamplerMode, ShadingMode};
 use quadray::scene::{parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 use quadray::vk::{Commands, Context};
 
@@ -26,6 +26,7 @@ const BRUTE_FORCE: RenderVariant = RenderVariant {
     volume: false,
     record_path: false,
     lookup: LookupMode::Probes,
+    sampler: SamplerMode::Sobol,
     backend: Some(quadray::vk::Backend::RayQuery),
 };
 

@@ -13,8 +13,8 @@
 //!
 //! Bounds: the mean signed relative error over the lit pixels (the bias)
 //! within `BIAS_BOUND`; no pixel further than `OUTLIER_SIGMAS` times the RMS
-//! relative error from its expected value (a local bias shows as outliers);
-//! the RMS (Monte Carlo noise at 256 spp, plus the jittered pixel footprint
+//! relative error from its expected value at two seeds (a local bias shows
+//! as a repeated outlier; see `check_scene`); the RMS (Monte Carlo noise at 256 spp, plus the jittered pixel footprint
 //! against a pixel-centre reference) below `RMS_BOUND`. Pixels where a
 //! jittered camera ray can see a sphere light directly are skipped.
 
@@ -23,6 +23,7 @@ use crate::common;
 use glam::{DAffine3, DVec3, Vec3};
 use quadray::geometry::{Aabb, FunctionalObject, Quadric};
 use quadray::passes::render::PIXEL_FILTER_REACH;
+use quadray::passes::{RenderVariant, SamplerMode};
 use quadray::scene::{Light, Material, Scene};
 
 const ALBEDO: f64 = 0.7;
@@ -77,16 +78,18 @@ fn check(name: &str, light: Option<Light>, background: f64, irradiance: impl Fn(
     check_scene(name, scene, irradiance);
 }
 
-fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) {
+/// The signed relative error of every lit pixel's radiance (`None` for a
+/// pixel left out: background, a visible sphere light, or too little light)
+/// in a render of `scene` with `sampler`.
+fn pixel_errors(scene: &Scene, sampler: SamplerMode, irradiance: &impl Fn(DVec3) -> f64) -> Vec<Option<f64>> {
     let visible_sphere = match scene.lights.first() {
         Some(Light::Sphere { centre, radius, .. }) => Some((*centre, *radius)),
         _ => None,
     };
-    let out = common::render_validated(&scene);
-
+    let out = common::render_variant_validated(scene, RenderVariant { sampler, ..Default::default() });
     let (w, h) = (out.width as usize, out.height as usize);
     let half = (0.5 * scene.camera.vfov_degrees).to_radians().tan();
-    let mut errors = Vec::new();
+    let mut errors = vec![None; w * h];
     for y in 0..h {
         for x in 0..w {
             let i = y * w + x;
@@ -116,23 +119,123 @@ fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) {
             if expected < 1e-3 {
                 continue;
             }
-            errors.push((out.radiance[i][0] as f64 - expected) / expected);
+            errors[i] = Some((out.radiance[i][0] as f64 - expected) / expected);
         }
     }
-    let n = errors.len() as f64;
-    let bias = errors.iter().sum::<f64>() / n;
-    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt();
-    let worst = errors.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    errors
+}
+
+/// Bias and RMS of the relative errors of the lit pixels.
+fn bias_and_rms(errors: &[Option<f64>]) -> (usize, f64, f64) {
+    let lit: Vec<f64> = errors.iter().flatten().copied().collect();
+    let n = lit.len() as f64;
+    let bias = lit.iter().sum::<f64>() / n;
+    let rms = (lit.iter().map(|e| e * e).sum::<f64>() / n).sqrt();
+    (lit.len(), bias, rms)
+}
+
+/// The largest error that two renders repeat at one pixel: for each pixel
+/// lit in both, the smaller of its two errors when they share a sign.
+fn repeated_error(a: &[Option<f64>], b: &[Option<f64>]) -> f64 {
+    a.iter()
+        .zip(b)
+        .filter_map(|(ea, eb)| match (ea, eb) {
+            (Some(ea), Some(eb)) if ea * eb > 0.0 => Some(ea.abs().min(eb.abs())),
+            _ => None,
+        })
+        .fold(0.0f64, f64::max)
+}
+
+/// The repeated-error statistic on synthetic errors: noise with the heavy
+/// tail of Sobol points (1 pixel in 400 at 16 RMS, elsewhere Gaussian)
+/// stays under the bound, and a local bias of 8 RMS at one pixel does not.
+#[test]
+fn repeated_errors_find_a_local_bias_and_pass_heavy_tailed_noise() {
+    use rand::Rng;
+    let mut rng = rand_pcg::Pcg64::new(7, 11);
+    let rms = 0.01;
+    let mut noise = |spike: bool| -> Vec<Option<f64>> {
+        (0..1600)
+            .map(|i| {
+                // Box-Muller.
+                let (u, v): (f64, f64) = (rng.gen::<f64>().max(1e-12), rng.gen());
+                let g = (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos() * rms;
+                Some(if spike && i % 400 == 17 { 16.0 * rms } else { g })
+            })
+            .collect()
+    };
+    let (a, b) = (noise(true), noise(false));
+    let (c, d) = (noise(false), noise(true));
+    assert!(repeated_error(&a, &b) <= OUTLIER_SIGMAS * rms, "noise with spikes at one seed");
+    assert!(repeated_error(&c, &d) <= OUTLIER_SIGMAS * rms, "noise with spikes at the other seed");
+    let (mut e, mut f) = (noise(false), noise(false));
+    e[900] = Some(8.0 * rms + e[900].unwrap());
+    f[900] = Some(8.0 * rms + f[900].unwrap());
+    assert!(repeated_error(&e, &f) > OUTLIER_SIGMAS * rms, "a local bias of 8 RMS goes unseen");
+}
+
+/// Renders `scene` with the renderer's sampler (Owen-scrambled Sobol points)
+/// at two seeds and checks the bias, the RMS and the local bias.
+///
+/// A local bias (a pixel whose expectation is wrong) shows at the same
+/// pixel, with the same sign, whatever the seed; noise does not. With
+/// independent samples the errors are near Gaussian and one render's worst
+/// pixel against its RMS finds a local bias, but Sobol points make the
+/// per-pixel error heavy-tailed: most pixels converge much faster than
+/// Monte Carlo (their RMS is 5x lower at 256 spp under the rect light)
+/// while a few samples' rare events, e.g. a BSDF-sampled ray that finds the
+/// light, keep the Monte Carlo rate, so a single pixel can err 16 RMS and
+/// the next seed puts that pixel at 1-2 RMS (measured: the rect light's
+/// worst pixel, 16.5 RMS at 256 spp, 0.123, falls to 0.037 at 1024 spp and
+/// 0.013 at 4096 spp, where other pixels take the lead). So the bound is on
+/// what repeats: for each pixel the smaller of its two errors when they
+/// share a sign, at most `OUTLIER_SIGMAS` times the larger RMS
+/// (`repeated_errors_find_a_local_bias_and_pass_heavy_tailed_noise`).
+///
+/// The rect light's bias, +0.0025 with both samplers at 256 to 4096 spp, is
+/// the reference's: it is each pixel's centre, and the Gaussian pixel
+/// filter (σ 0.5 px) averages the convex irradiance around it (quadrature
+/// of that average gives +0.0025 over the image).
+fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) -> f64 {
+    let mut second = scene.clone();
+    second.image.seed = scene.image.seed.wrapping_add(1);
+    let a = pixel_errors(&scene, SamplerMode::Sobol, &irradiance);
+    let b = pixel_errors(&second, SamplerMode::Sobol, &irradiance);
+    let (lit, bias_a, rms_a) = bias_and_rms(&a);
+    let (_, bias_b, rms_b) = bias_and_rms(&b);
+    let rms = rms_a.max(rms_b);
+    let repeated = repeated_error(&a, &b);
+    let worst = a.iter().flatten().fold(0.0f64, |m, e| m.max(e.abs()));
     println!(
-        "{name}: {} lit pixels, bias {bias:+.4} (bound ±{BIAS_BOUND}), RMS {rms:.4} (bound {RMS_BOUND}), worst \
-         {worst:.4} = {:.1} RMS (bound {OUTLIER_SIGMAS})",
-        errors.len(),
+        "{name}: {lit} lit pixels, bias {bias_a:+.4} / {bias_b:+.4} (bound ±{BIAS_BOUND}), RMS {rms_a:.4} / \
+         {rms_b:.4} (bound {RMS_BOUND}), worst {worst:.4}, worst repeated {repeated:.4} = {:.1} RMS (bound \
+         {OUTLIER_SIGMAS})",
+        repeated / rms.max(1e-12)
+    );
+    assert!(lit > 500, "{name}: too few lit pixels");
+    for bias in [bias_a, bias_b] {
+        assert!(bias.abs() <= BIAS_BOUND, "{name}: bias {bias}");
+    }
+    assert!(rms <= RMS_BOUND, "{name}: RMS {rms}");
+    assert!(repeated <= OUTLIER_SIGMAS * rms.max(1e-4), "{name}: a pixel errs {repeated} at both seeds");
+    rms_a
+}
+
+/// The same checks with independent samples, whose per-pixel errors are
+/// near Gaussian: one render, and its worst pixel against its RMS.
+fn check_independent(name: &str, scene: &Scene, irradiance: impl Fn(DVec3) -> f64) -> f64 {
+    let errors = pixel_errors(scene, SamplerMode::Independent, &irradiance);
+    let (lit, bias, rms) = bias_and_rms(&errors);
+    let worst = errors.iter().flatten().fold(0.0f64, |m, e| m.max(e.abs()));
+    println!(
+        "{name}, independent samples: {lit} lit pixels, bias {bias:+.4}, RMS {rms:.4}, worst {worst:.4} = {:.1} RMS",
         worst / rms.max(1e-12)
     );
-    assert!(errors.len() > 500, "{name}: too few lit pixels");
+    assert!(lit > 500, "{name}: too few lit pixels");
     assert!(bias.abs() <= BIAS_BOUND, "{name}: bias {bias}");
     assert!(rms <= RMS_BOUND, "{name}: RMS {rms}");
     assert!(worst <= OUTLIER_SIGMAS * rms.max(1e-4), "{name}: outlier {worst}");
+    rms
 }
 
 #[test]
@@ -162,12 +265,21 @@ fn sphere_light() {
     });
 }
 
+/// Also rendered with independent samples: both samplers pass, and the
+/// Sobol points' RMS error is the lower.
 #[test]
 fn rect_light() {
     let (corner, eu, ev, l) = (DVec3::new(-1.5, 2.0, -1.0), DVec3::new(3.0, 0.0, 0.0), DVec3::new(0.0, 0.0, 2.0), 4.0);
-    check("rect", Some(Light::Rect { corner, edge_u: eu, edge_v: ev, radiance: Vec3::splat(l as f32) }), 0.0, |x| {
-        rect_irradiance(x, corner, eu, ev, l)
-    });
+    let mut scene = floor_scene();
+    scene.lights.push(Light::Rect { corner, edge_u: eu, edge_v: ev, radiance: Vec3::splat(l as f32) });
+    let irradiance = |x: DVec3| rect_irradiance(x, corner, eu, ev, l);
+    let independent = check_independent("rect", &scene, irradiance);
+    let sobol = check_scene("rect", scene, irradiance);
+    println!("rect: RMS of Sobol points / independent samples {:.3}", sobol / independent);
+    assert!(
+        sobol < independent,
+        "rect: the Sobol points' RMS {sobol} is not below the independent samples' {independent}"
+    );
 }
 
 #[test]

@@ -89,6 +89,7 @@ fn bindings_and_constants_are_declared_by_name() {
     assert_eq!(render.spec_constants[&SPEC_LOOKUP_MODE], "LOOKUP_MODE");
     assert_eq!(render.spec_constants[&SPEC_RECORD_PATH], "RECORD_PATH");
     assert_eq!(render.spec_constants[&SPEC_FAR_RAYS], "FAR_RAYS");
+    assert_eq!(render.spec_constants[&SPEC_SAMPLER], "SAMPLER");
     assert_eq!(render.push_constant_size as usize, std::mem::size_of::<quadray::passes::gpu::RenderPush>());
     // Within a shader every binding number is one declaration, and every
     // shader's constants use the SPEC_* ids.
@@ -105,6 +106,7 @@ fn bindings_and_constants_are_declared_by_name() {
         SPEC_PROBE_CURVATURE,
         SPEC_LOOP_BUDGET,
         SPEC_FAR_RAYS,
+        SPEC_SAMPLER,
     ];
     for (name, iface) in &shaders {
         for id in iface.spec_constants.keys() {
