@@ -4,8 +4,21 @@
 //! 1.4 for Vulkan 1.2 with shaderc (glslang), with the constants of
 //! `src/shader_interface.rs` as #defines.
 //! The SPIR-V lands in OUT_DIR and is embedded by `src/shaders.rs`.
+//!
+//! It also generates, from the table `src/gpu_structs.toml`, the structs
+//! the host shares with the shaders: the GLSL header `gpu_structs.glsl`
+//! (OUT_DIR, found by `#include` after `glsl/`) and the Rust structs with
+//! their `host_layouts` (`gpu_structs.rs`, included by
+//! `src/passes/gpu.rs`).
 
 use std::path::Path;
+
+#[path = "src/vk/naming.rs"]
+mod naming;
+use naming::snake_case;
+
+/// The table of shared structs.
+const STRUCTS: &str = "src/gpu_structs.toml";
 
 fn interface_defines() -> Vec<(String, String)> {
     let text = std::fs::read_to_string("src/shader_interface.rs").expect("read src/shader_interface.rs");
@@ -17,6 +30,162 @@ fn interface_defines() -> Vec<(String, String)> {
             Some((name.trim().to_string(), format!("{value}u")))
         })
         .collect()
+}
+
+/// One struct of `src/gpu_structs.toml`: its GLSL and Rust names, its doc,
+/// the Rust derives, and its fields (GLSL name, GLSL type, doc).
+struct SharedStruct {
+    glsl: String,
+    rust: String,
+    doc: String,
+    derive: Vec<String>,
+    fields: Vec<[String; 3]>,
+}
+
+/// Reads `src/gpu_structs.toml` (its format is described at its top).
+fn shared_structs() -> Vec<SharedStruct> {
+    let text = std::fs::read_to_string(STRUCTS).unwrap_or_else(|e| panic!("{STRUCTS}: {e}"));
+    let table: toml::Table = text.parse().unwrap_or_else(|e| panic!("{STRUCTS}: {e}"));
+    let string = |v: &toml::Value, what: &str| -> String {
+        v.as_str().unwrap_or_else(|| panic!("{STRUCTS}: {what} is not a string")).to_string()
+    };
+    let mut out: Vec<SharedStruct> = Vec::new();
+    for s in table["struct"].as_array().unwrap_or_else(|| panic!("{STRUCTS}: no [[struct]] entries")) {
+        let glsl = string(&s["glsl"], "glsl");
+        let get = |key: &str| s.get(key).unwrap_or_else(|| panic!("{STRUCTS}: {glsl} has no `{key}`"));
+        let derive = match s.get("derive") {
+            Some(list) => list.as_array().expect("derive: a list").iter().map(|d| string(d, "derive")).collect(),
+            None => ["Clone", "Copy", "Debug", "Default", "Pod", "Zeroable"].map(String::from).to_vec(),
+        };
+        let fields = get("fields")
+            .as_array()
+            .expect("fields: a list")
+            .iter()
+            .map(|f| {
+                let f = f
+                    .as_array()
+                    .filter(|f| f.len() == 3)
+                    .unwrap_or_else(|| panic!("{STRUCTS}: {glsl}: a field is [name, GLSL type, doc]"));
+                [string(&f[0], "field"), string(&f[1], "type"), string(&f[2], "doc")]
+            })
+            .collect();
+        let rust = string(get("rust"), "rust");
+        let doc = string(get("doc"), "doc");
+        out.push(SharedStruct { glsl, rust, doc, derive, fields });
+    }
+    out
+}
+
+/// A GLSL type `T` or `T[N]` as its element type and length.
+fn split_array(ty: &str) -> (&str, Option<&str>) {
+    match ty.split_once('[') {
+        Some((element, rest)) => (element, Some(rest.trim_end_matches(']'))),
+        None => (ty, None),
+    }
+}
+
+/// The Rust type of a GLSL type of the table (scalar block layout): a
+/// vector is an array of its components, a struct is its Rust twin, an
+/// array's length a number or a constant of `src/shader_interface.rs`.
+fn rust_type(ty: &str, structs: &[SharedStruct], owner: &str) -> String {
+    let (element, len) = split_array(ty);
+    let base = match element {
+        "float" => "f32".to_string(),
+        "uint" => "u32".to_string(),
+        "int" => "i32".to_string(),
+        "double" => "f64".to_string(),
+        "vec2" => "[f32; 2]".to_string(),
+        "vec3" => "[f32; 3]".to_string(),
+        "vec4" => "[f32; 4]".to_string(),
+        "uvec2" => "[u32; 2]".to_string(),
+        "uvec3" => "[u32; 3]".to_string(),
+        "ivec2" => "[i32; 2]".to_string(),
+        other => match structs.iter().position(|s| s.glsl == other) {
+            Some(i) if structs[i].glsl != owner => structs[i].rust.clone(),
+            _ => panic!("{STRUCTS}: {owner}: unknown type {other} (a struct must come before its use)"),
+        },
+    };
+    match len {
+        Some(n) if n.chars().all(|c| c.is_ascii_digit()) => format!("[{base}; {n}]"),
+        Some(n) => format!("[{base}; crate::shader_interface::{n} as usize]"),
+        None => base,
+    }
+}
+
+/// `text` as comment lines of at most 100 columns after `prefix`.
+fn comment(text: &str, prefix: &str) -> String {
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        if !line.is_empty() && prefix.len() + line.len() + 1 + word.len() > 100 {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    lines.push(line);
+    lines.iter().map(|l| format!("{prefix}{l}\n")).collect()
+}
+
+/// The GLSL header `gpu_structs.glsl`: every struct of the table.
+fn glsl_structs(structs: &[SharedStruct]) -> String {
+    let mut out = format!(
+        "// Generated by build.rs from {STRUCTS}: edit that table, not this file.\n\
+         // The structs the host shares with the shaders (scalar block layout).\n\
+         #ifndef GPU_STRUCTS_GLSL\n#define GPU_STRUCTS_GLSL\n"
+    );
+    for s in structs {
+        out.push('\n');
+        out.push_str(&comment(&s.doc, "// "));
+        out.push_str(&format!("struct {} {{\n", s.glsl));
+        for [name, ty, doc] in &s.fields {
+            out.push_str(&comment(doc, "    // "));
+            let (element, len) = split_array(ty);
+            match len {
+                Some(n) => out.push_str(&format!("    {element} {name}[{n}];\n")),
+                None => out.push_str(&format!("    {element} {name};\n")),
+            }
+        }
+        out.push_str("};\n");
+    }
+    out.push_str("\n#endif\n");
+    out
+}
+
+/// The Rust structs of the table and `host_layouts`, included by
+/// `src/passes/gpu.rs`.
+fn rust_structs(structs: &[SharedStruct]) -> String {
+    let mut out = format!("// Generated by build.rs from {STRUCTS}: edit that table, not this file.\n");
+    for s in structs {
+        out.push('\n');
+        out.push_str(&comment(&s.doc, "/// "));
+        out.push_str(&format!("///\n/// GLSL: `{}` (`gpu_structs.glsl`).\n", s.glsl));
+        out.push_str(&format!("#[repr(C)]\n#[derive({})]\npub struct {} {{\n", s.derive.join(", "), s.rust));
+        for [name, ty, doc] in &s.fields {
+            out.push_str(&comment(doc, "    /// "));
+            out.push_str(&format!("    pub {}: {},\n", snake_case(name), rust_type(ty, structs, &s.glsl)));
+        }
+        out.push_str("}\n");
+    }
+    out.push_str(
+        "\n/// Every struct the host shares with the shaders, for the member-by-member\n\
+         /// check against their SPIR-V (`tests/scene/interface.rs`): names (GLSL\n\
+         /// `camelCase` as Rust `snake_case`), order, offsets, sizes.\n\
+         pub fn host_layouts() -> Vec<crate::vk::reflect::HostLayout> {\n    vec![\n",
+    );
+    for s in structs {
+        let fields: Vec<String> = s.fields.iter().map(|[name, _, _]| snake_case(name)).collect();
+        out.push_str(&format!(
+            "        crate::host_layout!({} as \"{}\" {{ {} }}),\n",
+            s.rust,
+            s.glsl,
+            fields.join(", ")
+        ));
+    }
+    out.push_str("    ]\n}\n");
+    out
 }
 
 /// The shader stage of a file extension, or None for other files.
@@ -34,7 +203,11 @@ fn shader_kind(extension: &str) -> Option<shaderc::ShaderKind> {
 fn main() {
     println!("cargo:rerun-if-changed=glsl");
     println!("cargo:rerun-if-changed=src/shader_interface.rs");
+    println!("cargo:rerun-if-changed={STRUCTS}");
     let out_dir = std::env::var("OUT_DIR").unwrap();
+    let structs = shared_structs();
+    std::fs::write(Path::new(&out_dir).join("gpu_structs.glsl"), glsl_structs(&structs)).unwrap();
+    std::fs::write(Path::new(&out_dir).join("gpu_structs.rs"), rust_structs(&structs)).unwrap();
     let compiler = shaderc::Compiler::new().expect("shaderc compiler");
     let defines = interface_defines();
     let mut sources: Vec<_> = std::fs::read_dir("glsl")
@@ -61,7 +234,8 @@ fn main() {
             options.add_macro_definition("RAY_TRACING_PIPELINE", Some("1"));
         }
         options.set_include_callback(|requested, _, _, _| {
-            let p = Path::new("glsl").join(requested);
+            let source = Path::new("glsl").join(requested);
+            let p = if source.exists() { source } else { Path::new(&out_dir).join(requested) };
             std::fs::read_to_string(&p)
                 .map(|content| shaderc::ResolvedInclude { resolved_name: p.to_string_lossy().into_owned(), content })
                 .map_err(|e| format!("{}: {e}", p.display()))

@@ -11,24 +11,6 @@
 // Below this GGX α a lobe is treated as a perfect specular (delta) lobe.
 const float ALPHA_DELTA = 1e-3;
 
-struct Material {
-    uint kind;          // MATERIAL_*
-    float albedo[3];    // diffuse albedo, mirror reflectance
-    float emission[3];
-    float roughness;    // conductor and dielectric; GGX α = roughness²
-    float ior;          // dielectric: n_inside / n_outside
-    uint fresnel;       // FRESNEL_COMPLEX or FRESNEL_SCHLICK (conductor)
-    float eta[3];       // conductor: η per RGB, or the Schlick f0
-    float k[3];         // conductor: κ per RGB
-    uint albedoMap;     // texture indices, NO_TEXTURE when absent
-    uint normalMap;
-    uint roughnessMap;
-    uint displacementMap;
-    float displacementScale;  // object units per unit of displacement
-    uint normalMoments;       // slope moments of the normal map (texture/lean.rs), or NO_TEXTURE
-    uint displacementMoments; // slope moments of the displacement map, or NO_TEXTURE
-    Medium medium;            // inside a dielectric (density 0: clear)
-};
 
 vec3 sampleCosineHemisphere(vec2 u) {
     float r = sqrt(u.x), phi = 2.0 * PI * u.y;

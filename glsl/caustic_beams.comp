@@ -31,7 +31,7 @@ layout(set = 0, binding = BINDING_GBUFFER, scalar) buffer Receivers { Receiver r
 // Per pixel: radiance × CAUSTIC_FIXED_POINT in R, G, B.
 layout(set = 0, binding = BINDING_CAUSTIC_BEAMS, scalar) buffer BeamMap { uint64_t beamMap[]; };
 
-layout(push_constant, scalar) uniform Push { Emitter emitter; } pc;
+layout(push_constant, scalar) uniform PushBlock { CausticPush pc; };
 
 CausticRay rayAt(ivec2 g) { return causticRays[pc.emitter.firstRay + uint(g.y) * pc.emitter.grid.x + uint(g.x)]; }
 

@@ -29,7 +29,7 @@ layout(local_size_x = CAUSTIC_GROUP) in;
 // Per pixel: irradiance × CAUSTIC_FIXED_POINT in R, G, B.
 layout(set = 0, binding = BINDING_CAUSTIC_MAP, scalar) buffer CausticMap { uint64_t causticMap[]; };
 
-layout(push_constant, scalar) uniform Push { Emitter emitter; } pc;
+layout(push_constant, scalar) uniform PushBlock { CausticPush pc; };
 
 CausticRay rayAt(ivec2 g) { return causticRays[pc.emitter.firstRay + uint(g.y) * pc.emitter.grid.x + uint(g.x)]; }
 

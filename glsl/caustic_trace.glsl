@@ -24,7 +24,7 @@ layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials {
 
 #include "stack.glsl"
 
-layout(push_constant, scalar) uniform Push { Emitter emitter; } pc;
+layout(push_constant, scalar) uniform PushBlock { CausticPush pc; };
 
 // Specialisation constant: 1 when the scene has a participating medium.
 layout(constant_id = SPEC_MEDIA_ENABLED) const uint MEDIA_ENABLED = 0u;

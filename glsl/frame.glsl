@@ -1,4 +1,4 @@
-// The per-frame parameters (host twin: GpuFrame in src/passes/gpu.rs), read
+// The per-frame parameters (Frame in gpu_structs.glsl; GpuFrame on the host), read
 // by the render pass and the passes that feed it (G-buffer, caustics).
 #ifndef FRAME_GLSL
 #define FRAME_GLSL
@@ -7,25 +7,7 @@
 #include "media.glsl"
 
 // Camera basis: ray direction = forward + x right + y up, x and y in [-1, 1].
-layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer Frame {
-    vec3 eye;
-    vec3 forward;
-    vec3 right;
-    vec3 up;
-    vec3 background;
-    uint width;
-    uint height;
-    uint seed;
-    uint lightCount;
-    uint maxDepth;
-    uint envMap;      // texture index of the environment map, or NO_TEXTURE
-    uint envWidth;
-    uint envHeight;
-    float envScale;
-    Medium fog;       // outside the objects (density 0: none)
-    float pixelSigma;         // the Gaussian pixel filter's σ, in pixels
-    float footprintFraction;  // the share of its variance that filtered modes' footprints carry
-} frame;
+layout(set = 0, binding = BINDING_FRAME, scalar) readonly buffer FrameBuffer { Frame frame; };
 
 // The direction through image position `pixel` (in pixels, y down).
 vec3 cameraRay(vec2 pixel) {

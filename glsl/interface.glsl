@@ -1,6 +1,10 @@
-// Data layouts shared with the host (src/passes/gpu.rs: host_layouts, which
-// tests/scene/interface.rs checks member by member against the SPIR-V). Binding numbers come from src/shader_interface.rs through
-// build.rs as #defines. All blocks use the scalar layout.
+// The scene's buffers and the extensions every pass uses. The structs in
+// them, like every struct shared with the host, come from
+// gpu_structs.glsl, which build.rs generates from src/gpu_structs.toml (the
+// Rust twins come from the same table; tests/scene/interface.rs checks
+// them member by member against the SPIR-V). Binding numbers come from
+// src/shader_interface.rs through build.rs as #defines. All blocks use the
+// scalar layout.
 #ifndef INTERFACE_GLSL
 #define INTERFACE_GLSL
 
@@ -17,54 +21,11 @@
 #extension GL_EXT_control_flow_attributes : require
 
 #include "common.glsl"
+#include "gpu_structs.glsl"
 
-// q(p) = pᵀAp + b·p + c with A symmetric: a0=Axx a1=Ayy a2=Azz a3=Axy a4=Ayz a5=Axz,
-// b = (b0,b1,b2), c.
-struct Quadric {
-    float a[6];
-    float b[3];
-    float c;
-};
 
-struct Object {
-    Quadric base;
-    uint material;
-    uint firstCell;    // cell of primitive 0 of the object's bottom level
-    uint uvMapping;    // UV_*
-    float uAxis[3];    // planar mapping: gradients of u and v (object frame)
-    float vAxis[3];
-    vec2 uvScale;
-    vec2 uvOffset;
-    // Rays whose object-frame origin is farther than this from the object's
-    // origin are formed in f64 and searched in a parameter local to each
-    // cell (root_search.glsl, candidateFirstRoot).
-    float rebaseDistance;
-    // The map from the GPU's world frame to the object's, in f64 (columns:
-    // x, y, z, translation): the hardware's f32 instance transform places an
-    // object D away only to ~6e-8 · D.
-    double worldToObject[12];
-};
 
-// A perturbation f · max(Q, 0)³ (48 bytes). A bounded support {Q >= 0} (an
-// ellipsoid) is stored about its centre, where Q has no linear term:
-// Q(p) = hᵀAh + c with h = p - centre, inside a sphere of `radius` about
-// `centre`. An unbounded support (radius < 0) is stored in the object frame
-// with its linear part b in the same three floats: Q(p) = pᵀAp + b·p + c.
-// perturbationQuadric and perturbationCentre (quadric.glsl) read either.
-struct Perturbation {
-    float a[6];
-    float c;
-    float f;
-    float centreOrLinear[3];
-    float radius;
-};
 
-struct Cell {
-    float lo[3];
-    float hi[3];
-    uint first;   // into the cell lists
-    uint count;
-};
 
 #ifndef NO_TRACING
 layout(set = 0, binding = BINDING_TLAS) uniform accelerationStructureEXT tlas;

@@ -10,14 +10,6 @@
 #include "common.glsl"
 #include "bsdf.glsl"
 
-struct Light {
-    uint kind;          // LIGHT_*
-    float position[3];  // point position, sphere centre, rect corner, directional: unit direction toward the light
-    float radius;       // sphere
-    float color[3];     // intensity (point), radiance (sphere, rect), irradiance (directional)
-    float edgeU[3];     // rect
-    float edgeV[3];     // rect; emits toward edgeU × edgeV
-};
 
 
 struct LightSample {

@@ -10,7 +10,7 @@
 
 layout(local_size_x = 8) in;
 
-layout(push_constant, scalar) uniform Push { uint spend; } pc;
+layout(push_constant, scalar) uniform PushBlock { LoopBudgetPush pc; };
 
 void main() {
     for (uint i = 0u; i < pc.spend; ++i) {

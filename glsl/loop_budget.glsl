@@ -17,14 +17,11 @@
 #ifndef LOOP_BUDGET_GLSL
 #define LOOP_BUDGET_GLSL
 
+#include "gpu_structs.glsl"
+
 layout(constant_id = SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
 
-layout(set = 0, binding = BINDING_LOOP_BUDGET, std430) buffer LoopBudget {
-    uint mostEdges;    // the most loop iterations one invocation counted
-    uint invocations;  // invocations that reported
-    uint spent;        // loop_budget.comp: iterations its uncounted loop ran
-    uint pad;
-} loopBudget;
+layout(set = 0, binding = BINDING_LOOP_BUDGET, std430) buffer LoopBudgetBuffer { LoopBudget loopBudget; };
 
 uint loopEdges = 0u;
 

@@ -8,12 +8,8 @@
 #define MEDIA_GLSL
 
 #include "common.glsl"
+#include "gpu_structs.glsl"
 
-struct Medium {
-    float density;     // σ_t per unit length; 0: no medium
-    float albedo[3];   // σ_s / σ_t per RGB channel
-    float anisotropy;  // g
-};
 
 const float HG_ISOTROPIC = 1e-3;
 const float HG_MAX_G = 0.99;

@@ -22,13 +22,14 @@ float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
 // Number of light-sampling choices: the lights, plus the environment.
 uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }
 
-// Next-event estimation at a vertex with a non-delta material: one light
+// Next-event estimation at a vertex with a non-delta material (pbrt-v4's
+// SampleLd): one light
 // chosen uniformly, weighted by multiple importance sampling against the
 // BSDF-sampled continuation (which every vertex has, the last one included:
 // see "the last vertex" in tracePath). Returns the light's contribution if
 // its shadow ray `sr` is unblocked.
-vec3 nextEvent(Material mat, mat3 frameW, vec3 wo, vec3 d, vec3 p, vec3 ng, float offset, Medium med, inout PathSampler rng,
-               out ShadowRay sr) {
+vec3 sampleLd(Material mat, mat3 frameW, vec3 wo, vec3 d, vec3 p, vec3 ng, float offset, Medium med, inout PathSampler rng,
+              out ShadowRay sr) {
     uint choices = lightChoices();
     if (choices == 0u) return vec3(0.0);
     uint i = min(uint(sample1(rng) * float(choices)), choices - 1u);

@@ -23,12 +23,12 @@ layout(constant_id = SPEC_VOLUME_ENABLED) const uint VOLUME_ENABLED = 0u;
 layout(constant_id = SPEC_BEAMS_ENABLED) const uint BEAMS_ENABLED = 0u;
 
 // In-scattered radiance per pixel from the volume pass (volume.comp).
-layout(set = 0, binding = BINDING_RENDER_VOLUME, scalar) readonly buffer Volume { float volume[]; };
+layout(set = 0, binding = BINDING_VOLUME, scalar) readonly buffer Volume { float volume[]; };
 
 #include "caustics.glsl"
-layout(set = 0, binding = BINDING_RENDER_GBUFFER, scalar) readonly buffer Receivers { Receiver receivers[]; };
-layout(set = 0, binding = BINDING_RENDER_CAUSTICS, scalar) readonly buffer CausticMap { uint64_t causticMap[]; };
+layout(set = 0, binding = BINDING_GBUFFER, scalar) readonly buffer Receivers { Receiver receivers[]; };
+layout(set = 0, binding = BINDING_CAUSTIC_MAP, scalar) readonly buffer CausticMap { uint64_t causticMap[]; };
 // Volumetric-caustic radiance per pixel (caustic_beams.comp), fixed point.
-layout(set = 0, binding = BINDING_RENDER_BEAMS, scalar) readonly buffer BeamMap { uint64_t beamMap[]; };
+layout(set = 0, binding = BINDING_CAUSTIC_BEAMS, scalar) readonly buffer BeamMap { uint64_t beamMap[]; };
 
 #endif

@@ -4,30 +4,14 @@
 #ifndef PATH_RECORD_GLSL
 #define PATH_RECORD_GLSL
 
+#include "gpu_structs.glsl"
+
 // Specialisation constant: 1 records every event of the path into `path`
 // (one pixel and one sample per dispatch: the outlier report's); 0 compiles
 // the recording out.
 layout(constant_id = SPEC_RECORD_PATH) const uint RECORD_PATH = 0u;
 
-// One recorded event (host twin: GpuPathVertex in src/passes/gpu.rs).
-struct PathVertex {
-    uint event;         // EVENT_*
-    uint object;        // object index, or the light index for emitters and light samples
-    uint material;      // material index (NO_TEXTURE when none)
-    uint lobe;          // LOBE_* (surface events), or the light kind
-    float t;            // ray parameter of the hit, or the shadow ray's length
-    float cosO;         // cosine of wo with the shading normal (signed)
-    float cosI;         // cosine of wi with the shading normal (signed)
-    float pdf;          // solid-angle pdf of the sample (0: delta), or the MIS weight for emitters
-    float position[3];
-    float weight[3];    // the sample's weight, or the contribution an emitter or shadow ray brings
-    float throughput[3];
-    float radiance[3];  // the sample's radiance so far
-};
-layout(set = 0, binding = BINDING_RENDER_PATH, scalar) buffer PathRecord {
-    uint count;
-    PathVertex vertices[PATH_RECORD_VERTICES];
-} path;
+layout(set = 0, binding = BINDING_RENDER_PATH, scalar) buffer PathRecordBuffer { PathRecord path; };
 
 void record(uint event, uint object, uint material, uint lobe, float t, float cosO, float cosI, float pdf, vec3 position,
             vec3 weight, vec3 throughput, vec3 radiance) {

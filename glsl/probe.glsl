@@ -6,21 +6,7 @@
 
 #include "intersect.glsl"
 
-struct Ray {
-    float origin[3];
-    float tmin;
-    float dir[3];
-    float tmax;
-};
 
-struct Hit {
-    float t;
-    float normal[3];
-    uint object;
-    float meanCurvature;   // of the outward normal (positive when convex)
-    float gaussCurvature;
-    float objectPoint[3];  // the hit in the object's frame (the far-view tests)
-};
 
 layout(set = 0, binding = BINDING_PROBE_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
 layout(set = 0, binding = BINDING_PROBE_HITS, scalar) writeonly buffer Hits { Hit hits[]; };
@@ -29,10 +15,7 @@ layout(set = 0, binding = BINDING_PROBE_HITS, scalar) writeonly buffer Hits { Hi
 // 0 to skip their Hessian (the ray benchmark times intersection alone).
 layout(constant_id = SPEC_PROBE_CURVATURE) const uint PROBE_CURVATURE = 1u;
 
-layout(push_constant, scalar) uniform Push {
-    uint first;
-    uint count;
-} pc;
+layout(push_constant, scalar) uniform PushBlock { ProbePush pc; };
 
 // Probes ray `pc.first + local`, if `local` < `pc.count`.
 void probeRay(uint local) {

@@ -81,7 +81,7 @@ bool positiveSomewhere(vec3 q, float lo, float hi) {
     return v > lo && v < hi && q.x + v * (q.y + v * q.z) > 0.0;
 }
 
-// Perturbation k's quadric about its centre (interface.glsl, Perturbation):
+// Perturbation k's quadric about its centre (gpu_structs.glsl, Perturbation):
 // Q(p) = quadricAt(perturbationQuadric(k), p - perturbationCentre(k)).
 Quadric perturbationQuadric(uint k) {
     bool bounded = perturbations[k].radius >= 0.0;

@@ -6,6 +6,7 @@
 #extension GL_EXT_nonuniform_qualifier : require
 
 #include "common.glsl"
+#include "gpu_structs.glsl"
 
 layout(local_size_x = PROBE_GROUP) in;
 
@@ -16,27 +17,12 @@ layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTU
 // Specialisation constant: LOOKUP_PROBES or LOOKUP_EWA.
 layout(constant_id = SPEC_LOOKUP_MODE) const uint LOOKUP_MODE = LOOKUP_EWA;
 
-struct TexQuery {
-    uint texture;
-    float alpha;
-    vec2 uv;
-    vec2 axis1;
-    vec2 axis2;
-};
 
-struct TexResult {
-    vec4 value;
-    float alpha;
-    uint pad[3];
-};
 
-layout(set = 0, binding = BINDING_TEXPROBE_QUERIES, scalar) readonly buffer Queries { TexQuery queries[]; };
-layout(set = 0, binding = BINDING_TEXPROBE_RESULTS, scalar) writeonly buffer Results { TexResult results[]; };
+layout(set = 0, binding = BINDING_TEXPROBE_QUERIES, scalar) readonly buffer TexQueries { TexQuery queries[]; };
+layout(set = 0, binding = BINDING_TEXPROBE_RESULTS, scalar) writeonly buffer TexResults { TexResult results[]; };
 
-layout(push_constant, scalar) uniform Push {
-    uint first;
-    uint count;
-} pc;
+layout(push_constant, scalar) uniform PushBlock { ProbePush pc; };
 
 void main() {
     if (gl_GlobalInvocationID.x >= pc.count) return;

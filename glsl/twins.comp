@@ -10,12 +10,7 @@
 
 layout(set = 0, binding = BINDING_TWIN_ENV_TABLE, scalar) readonly buffer EnvTable { float envTable[]; };
 layout(set = 0, binding = BINDING_TWIN_ENV_TEXELS, scalar) readonly buffer EnvTexels { vec4 envTexels[]; };
-layout(push_constant, scalar) uniform Push {
-    uint count;
-    uint envWidth;
-    uint envHeight;
-    float envScale;
-} pc;
+layout(push_constant, scalar) uniform PushBlock { TwinPush pc; };
 
 float envCdfAt(uint i) { return envTable[i]; }
 vec3 envTexelRadiance(ivec2 t) { return envTexels[uint(t.y) * pc.envWidth + uint(t.x)].rgb * pc.envScale; }
@@ -28,28 +23,10 @@ const uint OP_LIGHT = 1u;
 const uint OP_ENVIRONMENT = 2u;
 const uint OP_SOBOL = 3u;  // u: the pixel seed's bits, the sample index, the dimension
 
-struct TwinCase {
-    uint op;
-    Material mat;
-    Light light;
-    float wo[3];   // BSDF: outgoing direction (local frame)
-    float wi[3];   // BSDF: direction for eval/pdf; light: direction for lightPdf
-    float u[3];    // random numbers
-    float x[3];    // light: shading point
-};
 
-struct TwinResult {
-    float wi[3];
-    float weight[3];   // BSDF: sample weight; light: emitted radiance
-    float pdf;         // 0 for delta
-    uint valid;
-    float eval[3];     // BSDF: f(wo, wi)
-    float pdfOf;       // BSDF: pdf(wo, wi); light: lightPdf(x, wi)
-    float dist;        // light: distance to the light
-};
 
-layout(set = 0, binding = BINDING_TWIN_CASES, scalar) readonly buffer Cases { TwinCase cases[]; };
-layout(set = 0, binding = BINDING_TWIN_RESULTS, scalar) writeonly buffer Results { TwinResult results[]; };
+layout(set = 0, binding = BINDING_TWIN_CASES, scalar) readonly buffer TwinCases { TwinCase cases[]; };
+layout(set = 0, binding = BINDING_TWIN_RESULTS, scalar) writeonly buffer TwinResults { TwinResult results[]; };
 
 float[3] f3(vec3 v) { return float[3](v.x, v.y, v.z); }
 

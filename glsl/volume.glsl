@@ -30,11 +30,7 @@ layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light
 // Mean in-scattered radiance per pixel (RGB), accumulated over dispatches.
 layout(set = 0, binding = BINDING_VOLUME, scalar) buffer Volume { float volume[]; };
 
-layout(push_constant, scalar) uniform Push {
-    uint firstSample;  // index of this dispatch's first camera ray per pixel
-    uint samples;      // camera rays per pixel in this dispatch
-    uint total;        // camera rays per pixel over all dispatches
-} pc;
+layout(push_constant, scalar) uniform PushBlock { VolumePush pc; };
 
 // The light from light i scattered at o + t d toward the camera, before the
 // point's density: σ_s T(t) × the in-scattered radiance, whose direction

@@ -2,6 +2,10 @@
 // and passes every `pub const NAME: u32 = VALUE;` line to glslang as a
 // `#define NAME VALUE`, so bindings and enums are defined once.
 // Only such constant lines belong here.
+//
+// Every resource has one binding number, the same in every pass that
+// declares it, and no two resources share one
+// (tests/scene/interface.rs, one_binding_number_per_resource).
 
 /// Descriptor binding of the top-level acceleration structure.
 pub const BINDING_TLAS: u32 = 0;
@@ -24,21 +28,21 @@ pub const BINDING_ACCUM: u32 = 8;
 /// Descriptor binding of the AOV buffer (render pass).
 pub const BINDING_AOV: u32 = 9;
 /// Descriptor binding of the input rays (probe pass; it has no materials).
-pub const BINDING_PROBE_RAYS: u32 = 5;
+pub const BINDING_PROBE_RAYS: u32 = 19;
 /// Descriptor binding of the output hits (probe pass; it has no lights).
-pub const BINDING_PROBE_HITS: u32 = 6;
+pub const BINDING_PROBE_HITS: u32 = 20;
 /// Descriptor binding of the texture queries (texture probe pass).
-pub const BINDING_TEXPROBE_QUERIES: u32 = 1;
+pub const BINDING_TEXPROBE_QUERIES: u32 = 21;
 /// Descriptor binding of the texture probe results (texture probe pass).
-pub const BINDING_TEXPROBE_RESULTS: u32 = 2;
+pub const BINDING_TEXPROBE_RESULTS: u32 = 22;
 /// Descriptor binding of the sampling test cases (CPU-twin pass).
-pub const BINDING_TWIN_CASES: u32 = 0;
+pub const BINDING_TWIN_CASES: u32 = 23;
 /// Descriptor binding of the sampling test results (CPU-twin pass).
-pub const BINDING_TWIN_RESULTS: u32 = 1;
+pub const BINDING_TWIN_RESULTS: u32 = 24;
 /// Descriptor binding of the environment sampling table (CPU-twin pass).
-pub const BINDING_TWIN_ENV_TABLE: u32 = 2;
+pub const BINDING_TWIN_ENV_TABLE: u32 = 25;
 /// Descriptor binding of the environment texels (CPU-twin pass).
-pub const BINDING_TWIN_ENV_TEXELS: u32 = 3;
+pub const BINDING_TWIN_ENV_TEXELS: u32 = 26;
 /// Specialisation constant id: intersection mode (INTERSECT_*).
 pub const SPEC_INTERSECT_MODE: u32 = 0;
 /// Specialisation constant id: shading mode (SHADING_*).
@@ -134,16 +138,13 @@ pub const LOOKUP_PROBES: u32 = 0;
 /// one mip level (texfilter.glsl, ewaLookup; the reference lookup).
 pub const LOOKUP_EWA: u32 = 1;
 /// Descriptor binding of the caustic rays' landings (caustic passes).
-pub const BINDING_CAUSTIC_RAYS: u32 = 8;
-/// Descriptor binding of the G-buffer of pixel-centre receivers (G-buffer
-/// and caustic splat passes).
-pub const BINDING_GBUFFER: u32 = 9;
-/// Descriptor binding of the caustic irradiance buffer (caustic splat pass).
-pub const BINDING_CAUSTIC_MAP: u32 = 10;
-/// Descriptor binding of the G-buffer (render pass).
-pub const BINDING_RENDER_GBUFFER: u32 = 12;
-/// Descriptor binding of the caustic irradiance buffer (render pass).
-pub const BINDING_RENDER_CAUSTICS: u32 = 13;
+pub const BINDING_CAUSTIC_RAYS: u32 = 18;
+/// Descriptor binding of the G-buffer of pixel-centre receivers (written by
+/// the G-buffer pass, read by the caustic and render passes).
+pub const BINDING_GBUFFER: u32 = 12;
+/// Descriptor binding of the caustic irradiance buffer (written by the
+/// caustic splat pass, read by the render pass).
+pub const BINDING_CAUSTIC_MAP: u32 = 13;
 /// Workgroup size of the caustic passes.
 pub const CAUSTIC_GROUP: u32 = 64;
 /// Caustic emitter: rays from a point (point and sphere lights).
@@ -153,14 +154,12 @@ pub const EMITTER_PARALLEL: u32 = 1;
 /// Fixed-point scale of the caustic irradiance buffer (64-bit integer
 /// atomics): irradiance × 2^20 is added per pixel and channel.
 pub const CAUSTIC_FIXED_POINT: u32 = 1048576;
-/// Descriptor binding of the in-scattered radiance per pixel (volume pass).
-pub const BINDING_VOLUME: u32 = 8;
-/// Descriptor binding of the in-scattered radiance per pixel (render pass).
-pub const BINDING_RENDER_VOLUME: u32 = 14;
-/// Descriptor binding of the volumetric-caustic radiance buffer (caustic passes).
-pub const BINDING_CAUSTIC_BEAMS: u32 = 11;
-/// Descriptor binding of the volumetric-caustic radiance buffer (render pass).
-pub const BINDING_RENDER_BEAMS: u32 = 15;
+/// Descriptor binding of the in-scattered radiance per pixel (written by the
+/// volume pass, read by the render pass).
+pub const BINDING_VOLUME: u32 = 14;
+/// Descriptor binding of the volumetric-caustic radiance buffer (written by
+/// the caustic beam pass, read by the render pass).
+pub const BINDING_CAUSTIC_BEAMS: u32 = 15;
 /// Grid rays between the corners of a caustic beam (volumetric caustics use
 /// coarser cells than surface caustics: a beam's cost grows with its size
 /// on screen).

@@ -13,9 +13,9 @@ use super::volume::VolumeLight;
 use super::{RenderVariant, ShadingMode};
 use crate::scene::Scene;
 use crate::shader_interface::{
-    BINDING_ACCUM, BINDING_AOV, BINDING_ENV_CDF, BINDING_RENDER_BEAMS, BINDING_RENDER_CAUSTICS, BINDING_RENDER_GBUFFER,
-    BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, BINDING_RENDER_VOLUME, NO_TEXTURE, PATH_RECORD_VERTICES,
-    RENDER_GROUP, SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED, SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE,
+    BINDING_ACCUM, BINDING_AOV, BINDING_CAUSTIC_BEAMS, BINDING_CAUSTIC_MAP, BINDING_ENV_CDF, BINDING_GBUFFER,
+    BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, BINDING_VOLUME, NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP,
+    SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED, SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE,
     SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SAMPLER, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
 };
 use crate::vk::{vk, Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation, ShaderStage};
@@ -266,10 +266,10 @@ impl Renderer {
                 (BINDING_AOV, Binding::Buffer(&aov)),
                 gpu.texture_binding(),
                 (BINDING_ENV_CDF, Binding::Buffer(&gpu.env_cdf)),
-                (BINDING_RENDER_GBUFFER, Binding::Buffer(receivers)),
-                (BINDING_RENDER_CAUSTICS, Binding::Buffer(caustic_map)),
-                (BINDING_RENDER_VOLUME, Binding::Buffer(volume_radiance)),
-                (BINDING_RENDER_BEAMS, Binding::Buffer(beam_map)),
+                (BINDING_GBUFFER, Binding::Buffer(receivers)),
+                (BINDING_CAUSTIC_MAP, Binding::Buffer(caustic_map)),
+                (BINDING_VOLUME, Binding::Buffer(volume_radiance)),
+                (BINDING_CAUSTIC_BEAMS, Binding::Buffer(beam_map)),
                 (BINDING_RENDER_MAX_SAMPLE, Binding::Image(&max_sample)),
                 (BINDING_RENDER_PATH, Binding::Buffer(&path)),
             ]);

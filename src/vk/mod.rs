@@ -10,6 +10,7 @@ mod commands;
 mod device;
 mod image;
 mod instance;
+mod naming;
 mod pipeline;
 pub mod reflect;
 mod rt_pipeline;

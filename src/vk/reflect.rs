@@ -526,19 +526,7 @@ macro_rules! host_layout {
     };
 }
 
-/// `camelCase` to `snake_case` (GLSL member names to Rust field names).
-pub fn snake_case(name: &str) -> String {
-    let mut out = String::new();
-    for c in name.chars() {
-        if c.is_ascii_uppercase() {
-            out.push('_');
-            out.push(c.to_ascii_lowercase());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
+pub use super::naming::snake_case;
 
 /// Checks a host struct against the shader's layout of the same struct,
 /// member by member: the same names in the same order (GLSL `camelCase` as

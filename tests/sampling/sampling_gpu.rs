@@ -15,9 +15,8 @@
 
 use crate::common;
 
-use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3};
-use quadray::passes::gpu::{GpuLight, GpuMaterial};
+use quadray::passes::gpu::{GpuLight, GpuMaterial, TwinCase, TwinPush, TwinResult};
 use quadray::sampling::{self, Bsdf};
 use quadray::scene::{ConductorFresnel, Light, Material, MaterialKind};
 use quadray::vk::{vk, Binding, Buffer, Commands, ComputePipeline, MemoryLocation};
@@ -32,51 +31,17 @@ const GRAZING: f64 = 1e-3;
 const MAX_EDGE_SHARE: f64 = 0.002;
 const VNDF_RIM: f64 = 1e-3;
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct TwinCase {
-    op: u32,
-    mat: GpuMaterial,
-    light: GpuLight,
-    wo: [f32; 3],
-    wi: [f32; 3],
-    u: [f32; 3],
-    x: [f32; 3],
-}
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-struct TwinResult {
-    wi: [f32; 3],
-    weight: [f32; 3],
-    pdf: f32,
-    valid: u32,
-    eval: [f32; 3],
-    pdf_of: f32,
-    dist: f32,
-}
-
-/// `Push` in twins.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct TwinPush {
-    count: u32,
-    env_width: u32,
-    env_height: u32,
-    env_scale: f32,
-}
-
-/// The test's structs match twins.comp member by member (names, offsets,
-/// sizes), as `tests/scene/interface.rs` checks those of `passes::gpu`.
+/// twins.comp's structs (from src/gpu_structs.toml) match the shader
+/// member by member (names, offsets, sizes), as `tests/scene/interface.rs`
+/// checks them in every shader.
 #[test]
 fn twin_structs_match_the_shader() {
     let iface = quadray::vk::reflect::ShaderInterface::reflect(&quadray::shaders::twins()).unwrap();
-    for layout in [
-        quadray::host_layout!(TwinCase as "TwinCase" { op, mat, light, wo, wi, u, x }),
-        quadray::host_layout!(TwinResult as "TwinResult" { wi, weight, pdf, valid, eval, pdf_of, dist }),
-        quadray::host_layout!(TwinPush as "Push" { count, env_width, env_height, env_scale }),
-    ] {
-        quadray::vk::reflect::check_layout(&layout, &iface.structs[layout.glsl]).unwrap();
+    let layouts = quadray::passes::gpu::host_layouts();
+    let twins: Vec<_> = layouts.iter().filter(|l| l.glsl.starts_with("Twin")).collect();
+    assert_eq!(twins.len(), 3);
+    for layout in twins {
+        quadray::vk::reflect::check_layout(layout, &iface.structs[layout.glsl]).unwrap();
     }
 }
 

@@ -32,12 +32,9 @@ fn applies(layout: &HostLayout, shader: &str) -> bool {
     layout.shaders.is_empty() || layout.shaders.contains(&stem(shader))
 }
 
-/// Structs of the shaders that have no twin in `passes::gpu`, and why.
-const NOT_IN_GPU_RS: [(&str, &str, &str); 3] = [
-    ("twins", "Push", "the test's push constants, checked with its Rust twin in tests/sampling/sampling_gpu.rs"),
-    ("twins", "TwinCase", "a test input, checked with its Rust twin in tests/sampling/sampling_gpu.rs"),
-    ("twins", "TwinResult", "a test output, checked with its Rust twin in tests/sampling/sampling_gpu.rs"),
-];
+/// The blocks that hold one struct of `gpu_structs.glsl`: the push
+/// constants and the frame, path-record and loop-budget buffers.
+const WRAPPERS: [&str; 4] = ["PushBlock", "FrameBuffer", "PathRecordBuffer", "LoopBudgetBuffer"];
 
 #[test]
 fn host_structs_match_the_shaders_member_by_member() {
@@ -56,14 +53,44 @@ fn host_structs_match_the_shaders_member_by_member() {
     }
     for (name, iface) in &shaders {
         for (glsl, s) in &iface.structs {
-            // A buffer block around one runtime array is checked through
-            // the array's element (its stride is the element's size).
-            let block = s.members.len() == 1 && s.members[0].size == 0;
+            // A block around one runtime array is checked through the
+            // array's element (its stride is the element's size), a block
+            // around one struct through that struct.
+            let array = s.members.len() == 1 && s.members[0].size == 0;
+            let wrapper = s.members.len() == 1
+                && WRAPPERS.contains(&glsl.as_str())
+                && layouts.iter().any(|l| l.size == s.members[0].size && l.size == s.size());
             let twin = layouts.iter().any(|l| l.glsl == glsl && applies(l, name));
-            let exempt = NOT_IN_GPU_RS.iter().any(|(sh, g, _)| *sh == stem(name) && g == glsl);
-            assert!(block || twin || exempt, "struct {glsl} of {name} has no host twin in passes::gpu::host_layouts");
+            assert!(array || wrapper || twin, "struct {glsl} of {name} has no host twin in passes::gpu::host_layouts");
         }
     }
+}
+
+/// A binding number names one resource: every shader that declares it
+/// declares it under the same name and kind (the scene's tables, the
+/// G-buffer, the caustic, beam and volume buffers that one pass writes and
+/// the render pass reads).
+#[test]
+fn one_binding_number_per_resource() {
+    let mut seen: std::collections::BTreeMap<u32, (String, BindingKind, &str)> = Default::default();
+    for (shader, iface) in &interfaces() {
+        for (&number, b) in &iface.bindings {
+            let (name, kind, first) = seen.entry(number).or_insert((b.name.clone(), b.kind, shader));
+            assert_eq!(
+                (name.as_str(), *kind),
+                (b.name.as_str(), b.kind),
+                "binding {number} is {name} ({kind:?}) in {first} but {} ({:?}) in {shader}",
+                b.name,
+                b.kind
+            );
+        }
+    }
+    let names: Vec<_> = seen.iter().map(|(n, (name, _, _))| format!("{n} {name}")).collect();
+    eprintln!("{} resources: {}", seen.len(), names.join(", "));
+    let mut unique: Vec<_> = seen.values().map(|(name, _, _)| name.clone()).collect();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), seen.len(), "one resource under two binding numbers");
 }
 
 #[test]
@@ -74,12 +101,12 @@ fn bindings_and_constants_are_declared_by_name() {
         (BINDING_TLAS, "tlas", BindingKind::AccelerationStructure),
         (BINDING_OBJECTS, "Objects", BindingKind::StorageBuffer),
         (BINDING_MATERIALS, "Materials", BindingKind::StorageBuffer),
-        (BINDING_FRAME, "frame", BindingKind::StorageBuffer),
+        (BINDING_FRAME, "FrameBuffer", BindingKind::StorageBuffer),
         (BINDING_ACCUM, "accum", BindingKind::StorageImage),
         (BINDING_TEXTURES, "textures", BindingKind::SampledImages(MAX_TEXTURES)),
         (BINDING_RENDER_MAX_SAMPLE, "maxSample", BindingKind::StorageImage),
-        (BINDING_RENDER_PATH, "path", BindingKind::StorageBuffer),
-        (BINDING_LOOP_BUDGET, "loopBudget", BindingKind::StorageBuffer),
+        (BINDING_RENDER_PATH, "PathRecordBuffer", BindingKind::StorageBuffer),
+        (BINDING_LOOP_BUDGET, "LoopBudgetBuffer", BindingKind::StorageBuffer),
     ];
     for (binding, name, kind) in expect {
         let b = &render.bindings[&binding];

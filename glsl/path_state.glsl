@@ -1,0 +1,64 @@
+// What a path carries from vertex to vertex (render.glsl, tracePath), and
+// how it starts.
+#ifndef PATH_STATE_GLSL
+#define PATH_STATE_GLSL
+
+// A scattering event in a medium, for the weight of a positional light that
+// the sampled direction reaches: the segment it was on (origin, end
+// distance; direction), where on it, and the density σ_t T(t) there.
+struct MediumScatter {
+    vec4 segment;
+    vec3 dir;
+    float t;
+    float density;
+};
+
+// The state of a path between two of its segments.
+struct PathState {
+    vec3 o;  // the next segment's origin
+    vec3 d;  // and direction
+    vec3 radiance;
+    vec3 throughput;
+    // The product of the η² factors refractions divided the throughput by
+    // (Russian roulette's survival probability uses throughput × etaScale).
+    float etaScale;
+    float lastPdf;  // solid-angle pdf of the last BSDF sample; 0 after a delta lobe or the camera
+    vec3 lastPoint;
+    // After a scattering event in a medium: where it was (0 density after
+    // any other vertex).
+    MediumScatter scatter;
+    // Caustic paths: true while the path has gone from the primary receiver
+    // through the specular vertices that the caustic map covers; their count.
+    bool causticPath;
+    uint causticSpeculars;
+    // True when the last scattering event was on the camera ray's first
+    // segment and the volume pass covers it (VOLUME_ENABLED).
+    bool scatteredOnVolumeSegment;
+    // Scattering events so far (surfaces and media; an index-matched
+    // interface is not one), and segments traced (every interface counts).
+    uint bounce;
+    uint step;
+    bool alive;
+    MediaStack media;
+    // The footprint (ray cone or covariance, path_footprint.glsl).
+    PathFootprint foot;
+};
+
+// A path leaving the camera at o along d; its footprint starts as its share
+// of the pixel filter (cameraJitter).
+PathState pathStart(vec3 o, vec3 d) {
+    float pixelAngle = 2.0 * length(frame.up) / float(frame.height);
+    PathFootprint foot = footprintAtCamera(d, footprintSigma() * pixelAngle);
+    return PathState(o, d, vec3(0.0), vec3(1.0), 1.0, 0.0, o, MediumScatter(vec4(0.0), vec3(0.0), 0.0, 0.0), false, 0u,
+                     false, 0u, 0u, true, emptyStack(), foot);
+}
+
+// Russian roulette after a scattering event (none at the last vertex: its
+// continuation only looks for an emitter), then the next bounce.
+void nextBounce(inout PathState s, inout PathSampler rng) {
+    bool last = s.bounce + 1u == frame.maxDepth;
+    if (!last && !survives(s.throughput, s.etaScale, s.bounce, rng)) s.alive = false;
+    ++s.bounce;
+}
+
+#endif
