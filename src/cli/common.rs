@@ -157,26 +157,6 @@ pub(crate) fn read_scene(path: Option<&Path>) -> Result<Scene> {
     })
 }
 
-/// `--sampler`: where the path tracer's random decisions take their numbers.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) enum SamplerChoice {
-    /// Owen-scrambled Sobol points, one dimension pair per decision.
-    #[default]
-    Sobol,
-    /// Independent uniform random numbers.
-    Independent,
-}
-
-impl SamplerChoice {
-    /// The render shader's sampler.
-    pub(crate) fn mode(self) -> quadray::passes::SamplerMode {
-        match self {
-            SamplerChoice::Sobol => quadray::passes::SamplerMode::Sobol,
-            SamplerChoice::Independent => quadray::passes::SamplerMode::Independent,
-        }
-    }
-}
-
 /// `--backend`: how rays are traced.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) enum BackendChoice {

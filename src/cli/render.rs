@@ -7,7 +7,7 @@ use super::common::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
 use quadray::output::write_outputs_with;
-use quadray::passes::{IntersectMode, ShadingMode};
+use quadray::passes::{IntersectMode, SamplerMode, ShadingMode};
 use quadray::progress::ProgressBar;
 use quadray::scene::{Scene, DEFAULT_SCENE_NAME};
 
@@ -56,8 +56,8 @@ pub(crate) struct RenderArgs {
     /// spp) or `independent` (independent random numbers, whose per-pixel
     /// errors are plain Monte Carlo noise). Both are unbiased; the camera
     /// jitter is the same stratified sequence in both.
-    #[arg(long, value_enum, default_value_t = SamplerChoice::Sobol)]
-    pub(crate) sampler: SamplerChoice,
+    #[arg(long, default_value_t = SamplerMode::Sobol)]
+    pub(crate) sampler: SamplerMode,
     /// Write checkpoints of the work so far to this file (atomically), every
     /// --checkpoint-every seconds and when the render is stopped by SIGINT,
     /// SIGTERM or --time-limit; removed once the render completes and its
@@ -167,7 +167,7 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
     let variant = quadray::passes::RenderVariant {
         caustics: !args.brute_force,
         volume: !args.brute_force,
-        sampler: args.sampler.mode(),
+        sampler: args.sampler,
         backend: Some(backend),
         ..Default::default()
     };

@@ -98,12 +98,39 @@ pub enum SamplerMode {
 }
 
 impl SamplerMode {
+    /// Every sampler, in the order `--sampler` lists them.
+    pub const ALL: [SamplerMode; 2] = [SamplerMode::Sobol, SamplerMode::Independent];
+
+    /// The name `--sampler` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sobol => "sobol",
+            Self::Independent => "independent",
+        }
+    }
+
     /// The `SAMPLER_*` value the render shader is specialised with.
     pub fn constant(self) -> u32 {
         match self {
             Self::Sobol => SAMPLER_SOBOL,
             Self::Independent => SAMPLER_INDEPENDENT,
         }
+    }
+}
+
+impl std::fmt::Display for SamplerMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for SamplerMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown sampler `{s}`; expected one of: sobol, independent"))
     }
 }
 

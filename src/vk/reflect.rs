@@ -491,9 +491,6 @@ pub struct HostLayout {
     pub name: &'static str,
     /// The GLSL struct it mirrors.
     pub glsl: &'static str,
-    /// The shaders (file stems) whose struct of that name it mirrors; empty:
-    /// every shader that has one.
-    pub shaders: &'static [&'static str],
     /// `size_of` the type.
     pub size: usize,
     /// Every field: name, offset, size.
@@ -506,16 +503,13 @@ pub fn field_size<T, F>(_get: impl Fn(&T) -> &F) -> usize {
 }
 
 /// The [`HostLayout`] of a `#[repr(C)]` struct: `host_layout!(Type as
-/// "GlslName" { field, ... })`, or `... as "GlslName" in ["shader", ...] {
-/// ... }` for a struct name that differs between shaders (push blocks).
-/// Every field, in declaration order.
+/// "GlslName" { field, ... })`, every field in declaration order.
 #[macro_export]
 macro_rules! host_layout {
-    ($ty:ty as $glsl:literal $(in [$($shader:literal),*])? { $($field:ident),* $(,)? }) => {
+    ($ty:ty as $glsl:literal { $($field:ident),* $(,)? }) => {
         $crate::vk::reflect::HostLayout {
             name: stringify!($ty),
             glsl: $glsl,
-            shaders: &[$($($shader),*)?],
             size: ::std::mem::size_of::<$ty>(),
             fields: vec![$((
                 stringify!($field),

@@ -125,13 +125,27 @@ fn pixel_errors(scene: &Scene, sampler: SamplerMode, irradiance: &impl Fn(DVec3)
     errors
 }
 
-/// Bias and RMS of the relative errors of the lit pixels.
-fn bias_and_rms(errors: &[Option<f64>]) -> (usize, f64, f64) {
+/// The relative errors of the lit pixels, summed up.
+struct ErrorStats {
+    /// Lit pixels.
+    lit: usize,
+    /// Mean signed error.
+    bias: f64,
+    /// RMS error.
+    rms: f64,
+    /// Largest error in magnitude.
+    worst: f64,
+}
+
+fn error_stats(errors: &[Option<f64>]) -> ErrorStats {
     let lit: Vec<f64> = errors.iter().flatten().copied().collect();
     let n = lit.len() as f64;
-    let bias = lit.iter().sum::<f64>() / n;
-    let rms = (lit.iter().map(|e| e * e).sum::<f64>() / n).sqrt();
-    (lit.len(), bias, rms)
+    ErrorStats {
+        lit: lit.len(),
+        bias: lit.iter().sum::<f64>() / n,
+        rms: (lit.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
+        worst: lit.iter().fold(0.0f64, |m, e| m.max(e.abs())),
+    }
 }
 
 /// The largest error that two renders repeat at one pixel: for each pixel
@@ -201,11 +215,10 @@ fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) -> f
     second.image.seed = scene.image.seed.wrapping_add(1);
     let a = pixel_errors(&scene, SamplerMode::Sobol, &irradiance);
     let b = pixel_errors(&second, SamplerMode::Sobol, &irradiance);
-    let (lit, bias_a, rms_a) = bias_and_rms(&a);
-    let (_, bias_b, rms_b) = bias_and_rms(&b);
+    let ErrorStats { lit, bias: bias_a, rms: rms_a, worst } = error_stats(&a);
+    let ErrorStats { bias: bias_b, rms: rms_b, .. } = error_stats(&b);
     let rms = rms_a.max(rms_b);
     let repeated = repeated_error(&a, &b);
-    let worst = a.iter().flatten().fold(0.0f64, |m, e| m.max(e.abs()));
     println!(
         "{name}: {lit} lit pixels, bias {bias_a:+.4} / {bias_b:+.4} (bound ±{BIAS_BOUND}), RMS {rms_a:.4} / \
          {rms_b:.4} (bound {RMS_BOUND}), worst {worst:.4}, worst repeated {repeated:.4} = {:.1} RMS (bound \
@@ -225,8 +238,7 @@ fn check_scene(name: &str, scene: Scene, irradiance: impl Fn(DVec3) -> f64) -> f
 /// near Gaussian: one render, and its worst pixel against its RMS.
 fn check_independent(name: &str, scene: &Scene, irradiance: impl Fn(DVec3) -> f64) -> f64 {
     let errors = pixel_errors(scene, SamplerMode::Independent, &irradiance);
-    let (lit, bias, rms) = bias_and_rms(&errors);
-    let worst = errors.iter().flatten().fold(0.0f64, |m, e| m.max(e.abs()));
+    let ErrorStats { lit, bias, rms, worst } = error_stats(&errors);
     println!(
         "{name}, independent samples: {lit} lit pixels, bias {bias:+.4}, RMS {rms:.4}, worst {worst:.4} = {:.1} RMS",
         worst / rms.max(1e-12)

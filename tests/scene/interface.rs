@@ -9,7 +9,7 @@
 
 use quadray::passes::gpu::host_layouts;
 use quadray::shader_interface::*;
-use quadray::vk::reflect::{check_layout, HostLayout, InterfaceError, ShaderInterface};
+use quadray::vk::reflect::{check_layout, InterfaceError, ShaderInterface};
 use quadray::vk::BindingKind;
 
 /// Every compiled shader by name: the compute shaders by file stem
@@ -28,10 +28,6 @@ fn stem(shader: &str) -> &str {
     shader.split('.').next().unwrap_or(shader)
 }
 
-fn applies(layout: &HostLayout, shader: &str) -> bool {
-    layout.shaders.is_empty() || layout.shaders.contains(&stem(shader))
-}
-
 /// The blocks that hold one struct of `gpu_structs.glsl`: the push
 /// constants and the frame, path-record and loop-budget buffers.
 const WRAPPERS: [&str; 4] = ["PushBlock", "FrameBuffer", "PathRecordBuffer", "LoopBudgetBuffer"];
@@ -43,7 +39,7 @@ fn host_structs_match_the_shaders_member_by_member() {
     for layout in &layouts {
         let mut checked = Vec::new();
         for (name, iface) in &shaders {
-            if let Some(s) = iface.structs.get(layout.glsl).filter(|_| applies(layout, name)) {
+            if let Some(s) = iface.structs.get(layout.glsl) {
                 check_layout(layout, s).unwrap_or_else(|e| panic!("{name}: {e}"));
                 checked.push(*name);
             }
@@ -60,7 +56,7 @@ fn host_structs_match_the_shaders_member_by_member() {
             let wrapper = s.members.len() == 1
                 && WRAPPERS.contains(&glsl.as_str())
                 && layouts.iter().any(|l| l.size == s.members[0].size && l.size == s.size());
-            let twin = layouts.iter().any(|l| l.glsl == glsl && applies(l, name));
+            let twin = layouts.iter().any(|l| l.glsl == glsl);
             assert!(array || wrapper || twin, "struct {glsl} of {name} has no host twin in passes::gpu::host_layouts");
         }
     }
