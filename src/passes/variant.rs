@@ -127,10 +127,7 @@ impl std::fmt::Display for SamplerMode {
 impl std::str::FromStr for SamplerMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown sampler `{s}`; expected one of: sobol, independent"))
+        crate::scene::preset::from_name(&Self::ALL, Self::name, "sampler", s)
     }
 }
 

@@ -70,11 +70,17 @@ impl fmt::Display for FilterMode {
 impl FromStr for FilterMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown filter `{s}`; expected one of: none, ray-cones, covariance"))
+        from_name(&Self::ALL, Self::name, "filter", s)
     }
+}
+
+/// The value of `all` whose `name` is `s`, or an error that names `what`
+/// and lists every name (the `FromStr` of the named settings).
+pub(crate) fn from_name<T: Copy>(all: &[T], name: fn(T) -> &'static str, what: &str, s: &str) -> Result<T, String> {
+    all.iter().copied().find(|&v| name(v) == s).ok_or_else(|| {
+        let names: Vec<&str> = all.iter().map(|&v| name(v)).collect();
+        format!("unknown {what} `{s}`; expected one of: {}", names.join(", "))
+    })
 }
 
 /// The settings a preset fixes.
@@ -197,10 +203,7 @@ impl fmt::Display for Preset {
 impl FromStr for Preset {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|p| p.name() == s)
-            .ok_or_else(|| format!("unknown preset `{s}`; expected one of: preview, interactive, final, reference"))
+        from_name(&Self::ALL, Self::name, "preset", s)
     }
 }
 
