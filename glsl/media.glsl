@@ -36,6 +36,30 @@ vec3 sampleHg(float g, vec3 d, vec2 u) {
     return normalize(f[0] * (sinTheta * cos(phi)) + f[1] * (sinTheta * sin(phi)) + d * cosTheta);
 }
 
+// The halo strategy of a path's first scattering event in a medium (CPU
+// twin: sampling::phase::sample_halo, halo_pdf, HALO_SHARE): θ, the angle to
+// the axis a toward a light's centre, with density ∝ π − θ, φ uniform; its
+// solid-angle density (π − θ) / (π³ sin θ) has the shape of a small light's
+// single-scattering halo seen from the point (the airlight integral
+// (π − θ) / (D sin θ); Sun et al. 2005), so directions whose segment passes
+// close to the light, where that segment's equiangular estimate is large,
+// are sampled as often as they matter (the fireflies of multiple
+// scattering in haze).
+const float HALO_SHARE = 0.5;
+
+vec3 sampleHalo(vec3 a, vec2 u) {
+    float theta = PI * (1.0 - sqrt(max(0.0, 1.0 - u.x)));
+    float phi = 2.0 * PI * u.y;
+    mat3 f = frameAround(a);
+    return normalize(f[0] * (sin(theta) * cos(phi)) + f[1] * (sin(theta) * sin(phi)) + a * cos(theta));
+}
+
+float haloPdf(vec3 a, vec3 w) {
+    float sinTheta = length(cross(a, w));
+    float theta = atan(sinTheta, dot(a, w));
+    return (PI - theta) / (PI * PI * PI * max(sinTheta, 1e-12));
+}
+
 // Transmittance over a distance (grey).
 float transmittance(Medium m, float dist) { return m.density > 0.0 ? exp(-m.density * dist) : 1.0; }
 

@@ -35,7 +35,13 @@ bool mediumEvent(inout PathState s, Medium med, float tl, uint segment, bool vol
     bool positional = choices > 0u && positionalLight(li);
     ShadowRay sr;
     if (positional && !volumeSegment && !emitterOnly) {
-        vec3 c = equiangularNextEvent(med, s.o, s.d, tl, li, select, rng, sr);
+        // The halo share a scattering event on this segment would take
+        // (after its albedo and Russian roulette, below): its continuation
+        // competes with this estimate.
+        vec3 after = s.throughput * v3(med.albedo);
+        after /= lastVertex(s) ? 1.0 : survival(after, s.etaScale, s.bounce);
+        float share = haloShare(after, s.etaScale);
+        vec3 c = equiangularNextEvent(med, s.o, s.d, tl, share, li, select, rng, sr);
         queueShadowRay(sr, s.throughput * c);
     }
     float ts = -log(1.0 - sample1(rng)) / med.density;
@@ -48,12 +54,23 @@ bool mediumEvent(inout PathState s, Medium med, float tl, uint segment, bool vol
     }
     vec3 p = s.o + ts * s.d;
     s.throughput *= v3(med.albedo);
+    // Russian roulette before the direction is chosen: after it, a halo
+    // direction's small weight (phase / mixture, for a segment that passes
+    // close to a light) would be divided by as small a survival probability
+    // at the next vertex, before that segment's estimate.
+    if (!lastVertex(s) && !survives(s.throughput, s.etaScale, s.bounce, rng)) {
+        s.alive = false;
+        return true;
+    }
+    float share = haloShare(s.throughput, s.etaScale);
     if (choices > 0u && !positional) {
-        vec3 c = mediumNextEvent(med, s.d, p, li, select, rng, sr);
+        vec3 c = mediumNextEvent(med, s.d, p, share, li, select, rng, sr);
         queueShadowRay(sr, s.throughput * c);
     }
-    vec3 wi = sampleHg(med.anisotropy, s.d, sample2(rng));
-    s.lastPdf = hgPdf(med.anisotropy, dot(s.d, wi));
+    vec3 wi = sampleScatter(med, s.d, p, share, rng, s.lastPdf);
+    // The phase function over the density it was sampled with: 1, or at
+    // most 1 / (1 − share) after the halo mixture.
+    s.throughput *= hgPdf(med.anisotropy, dot(s.d, wi)) / s.lastPdf;
     record(EVENT_MEDIUM, NO_HIT, NO_TEXTURE, LOBE_REFLECT, ts, 0.0, dot(s.d, wi), s.lastPdf, p, v3(med.albedo),
            s.throughput, s.radiance);
     s.lastPoint = p;
@@ -67,7 +84,7 @@ bool mediumEvent(inout PathState s, Medium med, float tl, uint segment, bool vol
     s.causticPath = BEAMS_ENABLED != 0u && segment == 0u;
     s.causticSpeculars = 0u;
     s.scatteredOnVolumeSegment = volumeSegment;
-    nextBounce(s, rng);
+    ++s.bounce;
     return true;
 }
 

@@ -53,11 +53,14 @@ PathState pathStart(vec3 o, vec3 d) {
                      false, 0u, 0u, true, emptyStack(), foot);
 }
 
-// Russian roulette after a scattering event (none at the last vertex: its
-// continuation only looks for an emitter), then the next bounce.
+// True at the path's last vertex (its continuation only looks for an
+// emitter; no Russian roulette there).
+bool lastVertex(PathState s) { return s.bounce + 1u == frame.maxDepth; }
+
+// Russian roulette after a surface's scattering event (a medium's comes
+// before its direction is chosen: mediumEvent), then the next bounce.
 void nextBounce(inout PathState s, inout PathSampler rng) {
-    bool last = s.bounce + 1u == frame.maxDepth;
-    if (!last && !survives(s.throughput, s.etaScale, s.bounce, rng)) s.alive = false;
+    if (!lastVertex(s) && !survives(s.throughput, s.etaScale, s.bounce, rng)) s.alive = false;
     ++s.bounce;
 }
 

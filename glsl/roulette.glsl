@@ -14,9 +14,15 @@ const uint RR_DEPTH = 3u;
 // by that smaller probability would push the throughput above 1 when the
 // path leaves (a sample that gains energy). So the η-corrected throughput
 // never exceeds 1 (outliers.rs states the bound this gives).
+// The survival probability of Russian roulette at a vertex of bounce
+// `bounce` whose throughput is `throughput` (1: no roulette there).
+float survival(vec3 throughput, float etaScale, uint bounce) {
+    if (bounce + 1u < RR_DEPTH) return 1.0;
+    return clamp(max(throughput.x, max(throughput.y, throughput.z)) * etaScale, 0.05, 1.0);
+}
+
 bool survives(inout vec3 throughput, float etaScale, uint bounce, inout PathSampler rng) {
-    if (bounce + 1u < RR_DEPTH) return true;
-    float q = clamp(max(throughput.x, max(throughput.y, throughput.z)) * etaScale, 0.05, 1.0);
+    float q = survival(throughput, etaScale, bounce);
     if (q >= 1.0) return true;
     if (sample1(rng) > q) return false;
     throughput /= q;

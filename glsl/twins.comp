@@ -6,6 +6,7 @@
 #extension GL_EXT_control_flow_attributes : require
 
 #include "lights.glsl"
+#include "media.glsl"
 #include "sobol.glsl"
 
 layout(set = 0, binding = BINDING_TWIN_ENV_TABLE, scalar) readonly buffer EnvTable { float envTable[]; };
@@ -22,6 +23,7 @@ const uint OP_BSDF = 0u;
 const uint OP_LIGHT = 1u;
 const uint OP_ENVIRONMENT = 2u;
 const uint OP_SOBOL = 3u;  // u: the pixel seed's bits, the sample index, the dimension
+const uint OP_HALO = 4u;   // wo: the axis; u: the direction's two numbers; wi: a direction for haloPdf
 
 
 
@@ -45,6 +47,14 @@ void main() {
         r.weight = f3(vec3(0.0));
         r.pdf = 0.0;
         r.valid = 1u;
+    } else if (c.op == OP_HALO) {
+        vec3 a = normalize(v3(c.wo));
+        vec3 w = sampleHalo(a, vec2(c.u[0], c.u[1]));
+        r.wi = f3(w);
+        r.weight = f3(vec3(0.0));
+        r.pdf = haloPdf(a, w);
+        r.valid = 1u;
+        r.pdfOf = haloPdf(a, v3(c.wi));
     } else if (c.op == OP_BSDF) {
         vec3 wo = v3(c.wo), wi = v3(c.wi);
         BsdfSample s = bsdfSample(c.mat, wo, v3(c.u));

@@ -28,7 +28,12 @@
 //! sampling and the phase function, whose weight is the medium's albedo ≤ 1),
 //! and a scattering event in a medium is a bounce like a surface vertex. A
 //! path has at most `4 D + 8` segments (index-matched interfaces split a
-//! bounce's segment), so the bound grows by `L (2 D + 4)` there.
+//! bounce's segment), so the bound grows by `L (2 D + 4)` there. The
+//! scattering events in a medium sample their directions from a mixture of
+//! the phase function and a light's halo, whose weight phase / mixture can
+//! exceed 1; their share of the halo
+//! ([`crate::sampling::phase::halo_share`]) keeps the throughput at most 2,
+//! so the bound of a scene with media is multiplied by 2.
 //!
 //! The bound needs area emitters: point and directional lights have no
 //! radiance, and a sharp glossy lobe can legitimately turn one into an
@@ -98,7 +103,9 @@ impl SampleBound {
         let media = scene.has_media();
         let d = max_depth as f32;
         let per_segment = if media { 0.5 * (4.0 * d + 8.0) } else { 0.0 };
-        Ok(Self { luminance: emitted * (1.0 + 1.5 * d + per_segment), emitted, max_depth, media })
+        // The throughput's largest value with the halo mixture in media.
+        let halo = if media { 2.0 } else { 1.0 };
+        Ok(Self { luminance: emitted * (1.0 + 1.5 * d + per_segment) * halo, emitted, max_depth, media })
     }
 }
 

@@ -50,6 +50,10 @@ impl Pcg32 {
 /// — cells of equal solid angle, dω = d(cos θ) dφ. When `cap_cos` > −1 one
 /// more cell holds every direction with cos θ < `cap_cos`, which lets a
 /// narrow lobe be resolved by centring a small cap on it.
+///
+/// With `polar`, each cell's integral is taken over (θ, φ) with dω =
+/// sin θ dθ dφ instead: for densities with an integrable 1/sin θ pole at
+/// the axis (or its opposite), which the factor sin θ cancels.
 #[derive(Clone, Debug)]
 pub struct Chi2Config {
     /// Number of samples drawn (valid or not).
@@ -66,6 +70,8 @@ pub struct Chi2Config {
     pub seed: u64,
     /// Cells expecting fewer samples than this are pooled.
     pub min_expected: f64,
+    /// Integrate the cells over θ rather than cos θ (see above).
+    pub polar: bool,
 }
 
 impl Default for Chi2Config {
@@ -78,6 +84,7 @@ impl Default for Chi2Config {
             cap_cos: -1.0,
             seed: 0x5eed,
             min_expected: 5.0,
+            polar: false,
         }
     }
 }
@@ -297,7 +304,13 @@ where
         .map(|c| {
             let (mu, phi) = grid.bounds(c);
             let min_depth = if c == grid.nc * grid.np { 6 } else { 4 };
-            integrate_2d(&|m, p| pdf(grid.direction(m, p)), mu, phi, eps, min_depth, 20)
+            if config.polar {
+                let theta = (mu.1.clamp(-1.0, 1.0).acos(), mu.0.clamp(-1.0, 1.0).acos());
+                let f = |t: f64, p: f64| pdf(grid.direction(t.cos(), p)) * t.sin();
+                integrate_2d(&f, theta, phi, eps, min_depth, 20)
+            } else {
+                integrate_2d(&|m, p| pdf(grid.direction(m, p)), mu, phi, eps, min_depth, 20)
+            }
         })
         .collect();
     let pdf_mass: f64 = integrals.iter().sum();

@@ -43,6 +43,70 @@ pub fn sample_hg(g: f64, d: DVec3, u1: f64, u2: f64) -> DVec3 {
     (t * (sin_theta * phi.cos()) + b * (sin_theta * phi.sin()) + d * cos_theta).normalize()
 }
 
+/// Largest share of the scattered directions that a scattering event in a
+/// medium aims past a positional light ([`sample_halo`]) instead of sampling
+/// the phase function; the pair is one mixture density ([`scatter_pdf`])
+/// whose weight, phase / mixture, is at most 1 / (1 − share). [`halo_share`]
+/// takes less where that would lift a path's throughput above 2.
+pub const HALO_SHARE: f64 = 0.5;
+
+/// A direction around the unit axis `a` (from a scattering point toward a
+/// light's centre) with θ, its angle to `a`, of density ∝ π − θ on [0, π] and
+/// φ uniform. Its solid-angle density (π − θ) / (π³ sin θ) has the shape of
+/// a small light's halo seen from a point D away in a medium: the single
+/// scattering along a ray at angle θ, ∫_0^∞ dt / (D² + t² − 2 D t cos θ) =
+/// (π − θ) / (D sin θ) (the "airlight" integral; Sun, Ramamoorthi, Narasimhan,
+/// Nayar 2005, "A practical analytic single scattering model"), so a
+/// direction that passes close to the light, whose segment's equiangular
+/// estimate is large, is sampled as often as it matters. CPU twin of
+/// `sampleHalo` in `glsl/media.glsl`.
+pub fn sample_halo(a: DVec3, u1: f64, u2: f64) -> DVec3 {
+    let theta = PI * (1.0 - (1.0 - u1).max(0.0).sqrt());
+    let (sin_theta, cos_theta) = theta.sin_cos();
+    let phi = 2.0 * PI * u2;
+    let (t, b) = a.any_orthonormal_pair();
+    (t * (sin_theta * phi.cos()) + b * (sin_theta * phi.sin()) + a * cos_theta).normalize()
+}
+
+/// The solid-angle density of [`sample_halo`] around `a` at `w`.
+pub fn halo_pdf(a: DVec3, w: DVec3) -> f64 {
+    let sin_theta = a.cross(w).length();
+    let theta = sin_theta.atan2(a.dot(w));
+    (PI - theta) / (PI * PI * PI * sin_theta.max(1e-12))
+}
+
+/// The halo's share of the mixture at a scattering event in a medium, for a
+/// path whose throughput (η-corrected, after the event's albedo and Russian
+/// roulette; its largest channel) is `throughput`: [`HALO_SHARE`], less
+/// where the weight, at most 1 / (1 − share), could lift the throughput above
+/// 2, and 0 from 2 on. CPU twin of `haloShare` in `glsl/nee.glsl`.
+pub fn halo_share(throughput: f64) -> f64 {
+    (1.0 - 0.5 * throughput).clamp(0.0, HALO_SHARE)
+}
+
+/// The mixture density of a scattered direction in a medium: the phase
+/// function (travel direction `d`, anisotropy `g`) with weight 1 − `share`,
+/// and the halo around each of `axes` (toward the point and sphere lights,
+/// each alike) with `share`. With no axis or no share, the phase function alone.
+pub fn scatter_pdf(g: f64, d: DVec3, axes: &[DVec3], share: f64, w: DVec3) -> f64 {
+    let phase = hg_pdf(g, d.dot(w));
+    if axes.is_empty() || share <= 0.0 {
+        return phase;
+    }
+    let halo = axes.iter().map(|&a| halo_pdf(a, w)).sum::<f64>() / axes.len() as f64;
+    (1.0 - share) * phase + share * halo
+}
+
+/// A sample of [`scatter_pdf`]: `u[0]` picks the strategy (and, for the
+/// halo, which axis), `u[1]` and `u[2]` the direction.
+pub fn sample_scatter(g: f64, d: DVec3, axes: &[DVec3], share: f64, u: [f64; 3]) -> DVec3 {
+    if axes.is_empty() || u[0] >= share {
+        return sample_hg(g, d, u[1], u[2]);
+    }
+    let which = ((u[0] / share * axes.len() as f64) as usize).min(axes.len() - 1);
+    sample_halo(axes[which], u[1], u[2])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -82,6 +146,44 @@ mod tests {
             let n = 200000;
             let mean: f64 = (0..n).map(|i| sample_hg_cos(g, (i as f64 + 0.5) / n as f64)).sum::<f64>() / n as f64;
             assert!((mean - g).abs() < 1e-3, "g {g}: {mean}");
+        }
+    }
+
+    #[test]
+    fn halo_density_is_its_sampler_s_and_integrates_to_one() {
+        // Over θ about the axis (dω = sin θ dθ dφ cancels the density's
+        // 1/sin θ pole), by the midpoint rule: the density times sin θ is
+        // 2 (π − θ) / π² per radian once φ is integrated, whose integral is 1.
+        let a = DVec3::new(-0.2, 0.7, 0.4).normalize();
+        let (t, b) = a.any_orthonormal_pair();
+        let n = 20000;
+        let mut total = 0.0;
+        for i in 0..n {
+            let theta = PI * (i as f64 + 0.5) / n as f64;
+            let phi = 2.0 * PI * ((i * 7919) % n) as f64 / n as f64;
+            let w = (t * phi.cos() + b * phi.sin()) * theta.sin() + a * theta.cos();
+            let density = halo_pdf(a, w) * theta.sin() * 2.0 * PI;
+            assert!((density - 2.0 * (PI - theta) / (PI * PI)).abs() < 1e-9, "θ {theta}: {density}");
+            total += density * PI / n as f64;
+        }
+        assert!((total - 1.0).abs() < 1e-6, "{total}");
+    }
+
+    #[test]
+    fn the_mixture_weight_is_at_most_its_bound() {
+        // phase / mixture <= 1 / (1 - share) in every direction, and a
+        // throughput of at most 2 stays at most 2 (one above 2 does not grow).
+        let d = DVec3::new(0.1, 0.2, 0.97).normalize();
+        let axes = [DVec3::new(0.5, -0.5, 0.2).normalize()];
+        for throughput in [0.1, 0.5, 0.7, 0.95, 1.0, 1.6, 2.0, 2.5] {
+            let share = halo_share(throughput);
+            for i in 0..2000 {
+                let w = sample_hg(0.7, d, (i as f64 + 0.5) / 2000.0, (i as f64 * 0.618).fract());
+                let weight = hg_pdf(0.7, d.dot(w)) / scatter_pdf(0.7, d, &axes, share, w);
+                assert!(weight <= 1.0 / (1.0 - share) + 1e-12, "{weight}");
+                let after = throughput * weight;
+                assert!(after <= throughput.max(2.0) + 1e-12, "throughput {throughput}: {after}");
+            }
         }
     }
 }

@@ -598,3 +598,56 @@ fn gpu_sobol_samples_match_the_cpu_twin_to_the_bit() {
         &failures[..failures.len().min(5)]
     );
 }
+
+#[test]
+fn gpu_halo_sampling_matches_the_cpu_twin() {
+    use quadray::sampling::phase::{halo_pdf, sample_halo};
+    // The GPU builds its frame around the axis differently from glam's
+    // orthonormal pair, so a sample is compared by its angle to the axis
+    // (which carries the density; φ is uniform in both) and by the density
+    // there; the density at a given direction is compared directly, at
+    // directions of every angle (near the axis, where it has its pole, too).
+    let mut rng = Pcg64::seed_from_u64(31);
+    let mut cases = Vec::new();
+    for i in 0..20_000 {
+        let a = d3(f3(random_dir(&mut rng, false)));
+        let wi = if i % 4 == 0 {
+            // Within a few degrees of the axis.
+            d3(f3((a + random_dir(&mut rng, false) * rng.gen_range(0.001..0.1)).normalize()))
+        } else {
+            d3(f3(random_dir(&mut rng, false)))
+        };
+        let u = [rng.gen::<f32>(), rng.gen::<f32>(), 0.0];
+        cases.push(TwinCase {
+            op: 4,
+            mat: GpuMaterial::default(),
+            light: GpuLight::default(),
+            wo: f3(a),
+            wi: f3(wi),
+            u,
+            x: [0.0; 3],
+        });
+    }
+    let results = run_twins(&cases);
+    let (mut worst_angle, mut worst_pdf) = (0f64, 0f64);
+    let mut failures = Vec::new();
+    for (c, r) in cases.iter().zip(&results) {
+        let a = d3(c.wo).normalize();
+        let (wi, u) = (d3(c.wi).normalize(), c.u.map(f64::from));
+        let cpu = sample_halo(a, u[0], u[1]);
+        let gpu = d3(r.wi).normalize();
+        let angle = (a.dot(cpu).clamp(-1.0, 1.0).acos() - a.dot(gpu).clamp(-1.0, 1.0).acos()).abs();
+        let (dp, dq) = (rel(halo_pdf(a, gpu), r.pdf as f64), rel(halo_pdf(a, wi), r.pdf_of as f64));
+        worst_angle = worst_angle.max(angle);
+        worst_pdf = worst_pdf.max(dp).max(dq);
+        if angle > DIR_TOL || dp > REL_TOL || dq > REL_TOL || r.valid != 1 {
+            failures.push(format!("axis {a:?} u {u:?} wi {wi:?}: cpu {cpu:?}, gpu {r:?}"));
+        }
+    }
+    println!(
+        "halo twins: {} cases; worst: angle to the axis {worst_angle:.2e} (bound {DIR_TOL:e}), density {worst_pdf:.2e} \
+         (bound {REL_TOL:e})",
+        cases.len()
+    );
+    assert!(failures.is_empty(), "{} disagreements, e.g. {:?}", failures.len(), &failures[..failures.len().min(5)]);
+}
