@@ -5,9 +5,9 @@
 #ifndef PASS_INPUTS_GLSL
 #define PASS_INPUTS_GLSL
 
-// Specialisation constant: 1 when the caustic passes ran: the primary
-// diffuse vertex reads the caustic map, and the paths it covers are left out
-// (see "caustic paths" in tracePath); 0 compiles this out.
+// Specialisation constant: 1 when the caustic passes ran: the diffuse
+// vertices the caustic map covers read it, and the paths it covers are left
+// out (see "caustic paths" in tracePath); 0 compiles this out.
 layout(constant_id = SPEC_CAUSTICS_ENABLED) const uint CAUSTICS_ENABLED = 0u;
 
 // Specialisation constant: 1 when the volume pass ran: the camera ray's

@@ -94,11 +94,13 @@ layout(constant_id = SPEC_SHADING_MODE) const uint SHADING_MODE = SHADING_FULL;
 // is not a bounce; the segment count bounds the path all the same.
 //
 // Caustic paths: with CAUSTICS_ENABLED, the caustic map gives the light that
-// reaches the primary vertex (when it is the diffuse receiver seen through
-// the pixel centre) from point, sphere and directional lights through one or
-// more specular vertices of the kinds caustic_trace.comp follows. The path
-// therefore ignores a sphere light it finds after leaving that vertex
-// through such vertices only; every other path is estimated as usual.
+// reaches a diffuse vertex the map covers (the primary vertex when it is the
+// receiver seen through the pixel centre, or a later vertex within a pixel
+// of the receiver it projects to: causticPixel, surface_vertex.glsl) from
+// point, sphere and directional lights through one or more specular
+// vertices of the kinds caustic_trace.comp follows. The path therefore
+// ignores a sphere light it finds after leaving that vertex through such
+// vertices only; every other path is estimated as usual.
 vec3 tracePath(vec3 o, vec3 d, uint pixel, inout PathSampler rng) {
     PathState s = pathStart(o, d);
     // One past the last segment: the emitter-only one after the last vertex

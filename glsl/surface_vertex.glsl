@@ -19,17 +19,40 @@ bool albedoModeEnds(inout PathState s, Material mat) {
 
 // Caustic paths (CAUSTICS_ENABLED): the caustic rays pass dielectrics by
 // refraction (reflection only under total internal reflection) and reflect
-// off mirrors and smooth conductors; a path that leaves the primary
-// receiver through such vertices only is one the caustic map covers.
-void followCausticPath(inout PathState s, Material mat, bool primaryReceiver, vec3 wo, vec3 wi) {
+// off mirrors and smooth conductors; a path that leaves a receiver the map
+// covers (causticPixel) through such vertices only is one the caustic map
+// covers.
+void followCausticPath(inout PathState s, Material mat, bool receiver, vec3 wo, vec3 wi) {
     bool reflectedOffGlass = mat.kind == MATERIAL_DIELECTRIC && wi.z * wo.z > 0.0 && fresnelDielectric(wo.z, mat.ior) < 1.0;
-    if (primaryReceiver) {
+    if (receiver) {
         s.causticPath = true;
     } else if (s.causticPath && isDelta(mat) && !reflectedOffGlass) {
         ++s.causticSpeculars;
     } else {
         s.causticPath = false;
     }
+}
+
+// The caustic map's pixel that covers a diffuse vertex at p on `object`, or
+// NO_HIT: the primary vertex's own pixel when its receiver (the first
+// surface through the pixel centre) is this object; for a later vertex (seen
+// through the fog, or after a bounce) the pixel p projects to, when that
+// pixel's receiver is the same object within one pixel's width of p (the
+// map's own kernel). A vertex the map covers takes the light that reaches it
+// through specular objects from the map, and the paths that find that light
+// are left out (followCausticPath): so the floor under a glass seen through
+// haze gets its caustic from the caustic passes too, where brute force finds
+// it only by chance.
+uint causticPixel(uint object, vec3 p, uint bounce, uint pixel) {
+    if (bounce == 0u) return receivers[pixel].object == object ? pixel : NO_HIT;
+    vec2 px;
+    if (!project(p, px)) return NO_HIT;
+    ivec2 q = ivec2(floor(px));
+    if (any(lessThan(q, ivec2(0))) || q.x >= int(frame.width) || q.y >= int(frame.height)) return NO_HIT;
+    uint i = uint(q.y) * frame.width + uint(q.x);
+    Receiver r = receivers[i];
+    float pixelWidth = dot(p - frame.eye, frame.forward) * 2.0 * length(frame.up) / float(frame.height);
+    return r.object == object && distance(v3(r.position), p) < pixelWidth ? i : NO_HIT;
 }
 
 // The path reached surface hit `h` through medium `med` (pixel `pixel`'s
@@ -69,9 +92,10 @@ void surfaceVertex(inout PathState s, SceneHit h, Medium med, uint pixel, inout 
     vec3 n = mat.kind == MATERIAL_DIELECTRIC || dot(h.normal, s.d) < 0.0 ? ns : -ns;
     mat3 frameW = frameAround(n);
     vec3 wo = transpose(frameW) * -s.d;
-    bool primaryReceiver = CAUSTICS_ENABLED != 0u && s.bounce == 0u && mat.kind == MATERIAL_DIFFUSE
-        && receivers[pixel].object == h.object;
-    if (primaryReceiver) s.radiance += s.throughput * v3(mat.albedo) / PI * FIXED_POINT_RGB(causticMap, pixel);
+    uint mapPixel = CAUSTICS_ENABLED != 0u && mat.kind == MATERIAL_DIFFUSE ? causticPixel(h.object, p, s.bounce, pixel)
+                                                                             : NO_HIT;
+    bool receiver = mapPixel != NO_HIT;
+    if (receiver) s.radiance += s.throughput * v3(mat.albedo) / PI * FIXED_POINT_RGB(causticMap, mapPixel);
     if (SHADING_MODE == SHADING_FULL && !isDelta(mat)) {
         ShadowRay sr;
         vec3 c = sampleLd(mat, frameW, wo, s.d, p, h.normal, h.offset, med, rng, sr);
@@ -96,7 +120,7 @@ void surfaceVertex(inout PathState s, SceneHit h, Medium med, uint pixel, inout 
     }
     record(EVENT_SURFACE, h.object, matIndex, transmits ? LOBE_TRANSMIT : LOBE_REFLECT, h.t, wo.z, bs.wi.z, bs.pdf, p,
            bs.weight, s.throughput * bs.weight, s.radiance);
-    if (CAUSTICS_ENABLED != 0u) followCausticPath(s, mat, primaryReceiver, wo, bs.wi);
+    if (CAUSTICS_ENABLED != 0u) followCausticPath(s, mat, receiver, wo, bs.wi);
     bool last = s.bounce + 1u == frame.maxDepth;
     if (FILTER_MODE != FILTER_NONE && !last) {
         footprintBounce(s.foot, hitFoot, h, s.d, normalize(frameW * bs.wi), wo, bs.wi, mat.kind, mat.ior);

@@ -157,6 +157,10 @@ pub const CAUSTIC_FIXED_POINT: u32 = 1048576;
 /// Descriptor binding of the in-scattered radiance per pixel (written by the
 /// volume pass, read by the render pass).
 pub const BINDING_VOLUME: u32 = 14;
+/// Descriptor binding of the light maps (written by light_map.comp, read by
+/// the volume pass): per positional light, the distance from the pass's
+/// point on the light to the first surface in each direction.
+pub const BINDING_LIGHT_MAPS: u32 = 27;
 /// Descriptor binding of the volumetric-caustic radiance buffer (written by
 /// the caustic beam pass, read by the render pass).
 pub const BINDING_CAUSTIC_BEAMS: u32 = 15;

@@ -46,6 +46,8 @@ shaders! {
     caustic_beams,
     /// `glsl/volume.comp`: single scattering in the fog toward positional lights.
     volume,
+    /// `glsl/light_map.comp`: the volume pass's light maps.
+    light_map,
     /// `glsl/loop_budget.comp`: calibrates the loop-budget counter (a test
     /// spends known back-edges, then reads the budget left).
     loop_budget,
@@ -78,6 +80,8 @@ pipeline_shaders! {
     caustic_trace_rgen = "caustic_trace.rgen",
     /// `glsl/volume.rgen`: the volume pass.
     volume_rgen = "volume.rgen",
+    /// `glsl/light_map.rgen`: the volume pass's light maps.
+    light_map_rgen = "light_map.rgen",
     /// `glsl/probe.rgen`: the probe pass's ray generation.
     probe_rgen = "probe.rgen",
     /// `glsl/intersect.rint`: the first root in a candidate box.

@@ -265,10 +265,8 @@ pub struct BruteForceComparison {
 pub const EQUAL_TIME_MARGIN: f64 = 1.5;
 
 /// Renders `scenes/tests/{name}.toml` three ways (see
-/// [`BruteForceComparison`]): the brute-force spp is measured from a
-/// render at `spp`, then raised to EQUAL_TIME_MARGIN times the GPU time of
-/// the render with the passes. With QUADRAY_TEST_IMAGES set to a folder,
-/// writes the three images there as `{name}_*.png`.
+/// [`BruteForceComparison`]): the reference by brute force at
+/// `reference_spp`, then as [`equal_time`].
 pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> BruteForceComparison {
     use quadray::passes::RenderVariant;
     let mut scene = project_scene(&format!("tests/{name}.toml"));
@@ -278,13 +276,37 @@ pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> Bru
     assert!(reference.caustics.is_none() && reference.volume_seconds.is_none());
     // Other random numbers than the reference's (the same seed would make
     // the first `spp` samples of the reference those of `brute`).
-    scene.image.spp = spp;
     scene.image.seed = scene.image.seed.wrapping_add(1);
+    let file = format!("scenes/tests/{name}.toml");
+    equal_time(name, &file, &scene, reference, &format!("brute force at {reference_spp} spp"), spp)
+}
+
+/// `scene` (from `file`) with the passes at `spp` and by brute force at
+/// EQUAL_TIME_MARGIN times their GPU time (measured from a render at
+/// `spp`), both against `reference` (`what`: how it was made). With
+/// QUADRAY_TEST_IMAGES set to a folder, writes the three images there as
+/// `{name}_*.png`; with QUADRAY_EQUAL_TIME set to a JSON file, records the
+/// figures there as `{"scene", "brute_relmse", "passes_relmse", "brute_s",
+/// "passes_s"}` (replacing the scene's earlier entry; issue 30's
+/// `results/caustics/equal_time.json`).
+pub fn equal_time(
+    name: &str,
+    file: &str,
+    scene: &quadray::scene::Scene,
+    reference: quadray::passes::RenderOutput,
+    what: &str,
+    spp: u32,
+) -> BruteForceComparison {
+    use quadray::passes::RenderVariant;
+    let brute_force = RenderVariant { caustics: false, volume: false, ..Default::default() };
+    let mut scene = scene.clone();
+    scene.image.spp = spp;
     // Untimed: lavapipe compiles each shader variant at its first dispatch
     // (into its disk cache), and that time would count as GPU time.
     let mut small = scene.clone();
     (small.image.width, small.image.height, small.image.spp) = (8, 8, 1);
     render_variant_validated(&small, RenderVariant::default());
+    render_variant_validated(&small, brute_force);
     let fast = render_variant_validated(&scene, RenderVariant::default());
     let probe = render_variant_validated(&scene, brute_force);
     let per_sample = probe.seconds / spp as f64;
@@ -296,12 +318,13 @@ pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> Bru
     let rel_brute = quadray::metrics::relative_mse(&reference, &brute).unwrap();
     println!(
         "{name}: passes at {spp} spp in {:.2} s GPU; brute force at {} spp in {:.2} s ({:.2}x the time); \
-         against brute force at {reference_spp} spp: relMSE {rel_fast:.5} against {rel_brute:.5}, FLIP \
-         {flip_fast:.4} against {flip_brute:.4}",
+         against {what}: relMSE {rel_fast:.5} against {rel_brute:.5} ({:.2}x), FLIP {flip_fast:.4} against \
+         {flip_brute:.4}",
         fast.seconds,
         brute.spp,
         brute.seconds,
-        brute.seconds / fast.seconds
+        brute.seconds / fast.seconds,
+        rel_fast / rel_brute
     );
     if let Ok(dir) = std::env::var("QUADRAY_TEST_IMAGES") {
         let dir = std::path::Path::new(&dir);
@@ -309,5 +332,34 @@ pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> Bru
             quadray::output::write_png(out, 0.0, &dir.join(format!("{name}_{kind}.png"))).unwrap();
         }
     }
+    if let Ok(path) = std::env::var("QUADRAY_EQUAL_TIME") {
+        let entry = serde_json::json!({
+            "scene": file,
+            "size": [scene.image.width, scene.image.height],
+            "reference": what,
+            "passes_spp": spp,
+            "brute_spp": brute.spp,
+            "brute_relmse": rel_brute,
+            "passes_relmse": rel_fast,
+            "brute_s": brute.seconds,
+            "passes_s": fast.seconds,
+        });
+        record_equal_time(std::path::Path::new(&path), entry);
+    }
     BruteForceComparison { reference, fast, brute, flip_fast, flip_brute, rel_fast, rel_brute }
+}
+
+/// Adds `entry` to the JSON array in `path` (created when missing), in
+/// place of an entry of the same scene; tests that run at once take turns.
+fn record_equal_time(path: &std::path::Path, entry: serde_json::Value) {
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let mut all: Vec<serde_json::Value> = std::fs::read_to_string(path)
+        .ok()
+        .map(|s| serde_json::from_str(&s).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+        .unwrap_or_default();
+    all.retain(|e| e["scene"] != entry["scene"]);
+    all.push(entry);
+    all.sort_by(|a, b| a["scene"].as_str().cmp(&b["scene"].as_str()));
+    std::fs::write(path, serde_json::to_string_pretty(&all).unwrap() + "\n").unwrap();
 }

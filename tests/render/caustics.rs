@@ -125,7 +125,29 @@ fn lens_in_fog_beams_match_the_brute_force_path_tracer() {
         c.flip_fast
     );
     // At equal GPU time brute force's error is below the passes' here
-    // (relMSE 0.07 against 0.22 when measured): the beams do not pay yet
-    // (issue 16's note), so this test bounds the passes' error only.
+    // (relMSE 0.119 against 0.187 when measured for issue 30; 0.07-0.14
+    // against 0.22 before): the beams do not pay yet (their kernels do not
+    // shrink: issue 30's note), so this test bounds the passes' error only.
     assert!(c.flip_fast < LENS_FOG_FLIP_BOUND);
+}
+
+/// The glass vessel of the paper's figure 2 at 256x192: the passes at 64 spp
+/// against brute force at equal time, both against the cached reference
+/// `results/caustics/vessel_reference.exr` (results/caustics/README.md says
+/// how it was made and how far it is from converged). Minutes long, so run
+/// on demand: `QUADRAY_EQUAL_TIME=results/caustics/equal_time.json cargo
+/// test --release --test render -- --ignored glass_vessel`. It asserts what
+/// holds today: the passes' FLIP is below brute force's at equal time (the
+/// relative MSE, issue 30's measure, is printed and recorded; its target,
+/// 0.2x brute force's, is not met).
+#[test]
+#[ignore]
+fn glass_vessel_at_equal_time() {
+    let mut scene = common::project_scene("glass_vessel.toml");
+    (scene.image.width, scene.image.height, scene.image.seed) = (256, 192, 1);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results/caustics/vessel_reference.exr");
+    let reference = quadray::output::read_render_exr(&path).unwrap().output;
+    let what = "results/caustics/vessel_reference.exr (brute force, 4096 spp)";
+    let c = common::equal_time("glass_vessel", "scenes/glass_vessel.toml", &scene, reference, what, 64);
+    assert!(c.flip_fast < c.flip_brute, "FLIP {} not below brute force's {}", c.flip_fast, c.flip_brute);
 }

@@ -237,5 +237,5 @@ fn every_pipeline_declares_the_interface_of_its_compute_twin() {
         eprintln!("{name} + shared stages = {}.comp: {} bindings", stem(name), pipeline.bindings.len());
         checked += 1;
     }
-    assert_eq!(checked, 5, "render, gbuffer, caustic_trace, volume and probe have pipelines");
+    assert_eq!(checked, 6, "render, gbuffer, caustic_trace, volume, light_map and probe have pipelines");
 }
