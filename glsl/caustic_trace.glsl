@@ -9,7 +9,9 @@
 // Each ray follows one deterministic path so that grid neighbours stay
 // comparable: transmission at a dielectric (its weight 1 − F; reflection only
 // under total internal reflection), reflection at mirrors and conductors
-// (weight: their reflectance). Media along the way attenuate it by their
+// (weight: their reflectance); the rays of a reflecting grid
+// (Emitter.reflectFirst) reflect instead at their first vertex (weight F),
+// which must be glass. Media along the way attenuate it by their
 // transmittance. The render pass leaves out exactly these paths from its own
 // estimate (see render.comp, "caustic paths"), so nothing is counted twice.
 #include "intersect.glsl"
@@ -100,7 +102,15 @@ void traceCausticRay(uint i) {
             }
             float etaRel = entering ? eta : 1.0 / eta;  // n_t / n_i
             float f = fresnelDielectric(cosI, etaRel);
-            if (f < 1.0) {
+            if (e.reflectFirst != 0u && speculars == 0u) {
+                // The reflecting grid: reflection (weight F) at the first
+                // vertex, unless the glass reflects totally there (the
+                // refracting grid has that path).
+                if (!(f < 1.0)) break;
+                d = reflected;
+                flux *= f;
+                event = 2u;
+            } else if (f < 1.0) {
                 float cosT = sqrt(max(0.0, 1.0 - (1.0 - cosI * cosI) / (etaRel * etaRel)));
                 d = normalize(d / etaRel + (cosI / etaRel - cosT) * n);
                 flux *= 1.0 - f;
@@ -111,6 +121,9 @@ void traceCausticRay(uint i) {
                 event = 2u;
             }
         } else {
+            // The reflecting grid starts at glass only (the refracting grid
+            // has the paths that start at a mirror).
+            if (e.reflectFirst != 0u && speculars == 0u) break;
             d = reflected;
             flux *= mat.kind == MATERIAL_MIRROR ? v3(mat.albedo) : conductorFresnel(mat, cosI);
             event = 3u;

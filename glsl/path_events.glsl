@@ -83,6 +83,7 @@ bool mediumEvent(inout PathState s, Medium med, float tl, uint segment, bool vol
     // the beam map's volumetric caustics.
     s.causticPath = BEAMS_ENABLED != 0u && segment == 0u;
     s.causticSpeculars = 0u;
+    s.causticReflected = false;
     s.scatteredOnVolumeSegment = volumeSegment;
     ++s.bounce;
     return true;

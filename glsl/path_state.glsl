@@ -31,6 +31,10 @@ struct PathState {
     // through the specular vertices that the caustic map covers; their count.
     bool causticPath;
     uint causticSpeculars;
+    // True once such a path has reflected off glass (the caustic rays'
+    // reflecting grids cover that reflection as the last vertex before the
+    // light only).
+    bool causticReflected;
     // True when the last scattering event was on the camera ray's first
     // segment and the volume pass covers it (VOLUME_ENABLED).
     bool scatteredOnVolumeSegment;
@@ -50,7 +54,7 @@ PathState pathStart(vec3 o, vec3 d) {
     float pixelAngle = 2.0 * length(frame.up) / float(frame.height);
     PathFootprint foot = footprintAtCamera(d, footprintSigma() * pixelAngle);
     return PathState(o, d, vec3(0.0), vec3(1.0), 1.0, 0.0, o, MediumScatter(vec4(0.0), vec3(0.0), 0.0, 0.0), false, 0u,
-                     false, 0u, 0u, true, emptyStack(), foot);
+                     false, false, 0u, 0u, true, emptyStack(), foot);
 }
 
 // True at the path's last vertex (its continuation only looks for an

@@ -19,15 +19,19 @@ bool albedoModeEnds(inout PathState s, Material mat) {
 
 // Caustic paths (CAUSTICS_ENABLED): the caustic rays pass dielectrics by
 // refraction (reflection only under total internal reflection) and reflect
-// off mirrors and smooth conductors; a path that leaves a receiver the map
-// covers (causticPixel) through such vertices only is one the caustic map
-// covers.
+// off mirrors and smooth conductors, and those of the reflecting grids
+// reflect off the first glass they meet (caustic_trace.glsl); a path that
+// leaves a receiver the map covers (causticPixel) through such vertices only
+// (a reflection off glass, seen from the camera's side, only as the last
+// vertex before the light) is one the caustic map covers.
 void followCausticPath(inout PathState s, Material mat, bool receiver, vec3 wo, vec3 wi) {
     bool reflectedOffGlass = mat.kind == MATERIAL_DIELECTRIC && wi.z * wo.z > 0.0 && fresnelDielectric(wo.z, mat.ior) < 1.0;
     if (receiver) {
         s.causticPath = true;
-    } else if (s.causticPath && isDelta(mat) && !reflectedOffGlass) {
+        s.causticReflected = false;
+    } else if (s.causticPath && isDelta(mat) && !s.causticReflected) {
         ++s.causticSpeculars;
+        s.causticReflected = reflectedOffGlass;
     } else {
         s.causticPath = false;
     }

@@ -344,6 +344,12 @@ pub(crate) struct OutliersArgs {
     /// Enable the Khronos validation layer; the command fails if it reports errors.
     #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
     pub(crate) validation: bool,
+    /// Render with the caustic and volume passes the scene needs instead of
+    /// by brute force: the samples and paths left are those the passes do not
+    /// cover (a sample at a vertex the caustic map covers includes the map's
+    /// per-pixel estimate, so the bound may not hold for it)
+    #[arg(long)]
+    pub(crate) passes: bool,
 }
 
 /// `quadray outliers`: samples over the scene's bound, and their paths.
@@ -361,8 +367,11 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
         Some(b) => b,
         None => {
             let b = SampleBound::of(&scene).context("give the bound with --bound")?;
-            let media =
-                if b.media { format!(" + 0.5 x {} segments in media", 4 * b.max_depth + 8) } else { String::new() };
+            let media = if b.media {
+                format!(" + 0.5 x {} segments in media) x 2 (guided directions in media", 4 * b.max_depth + 8)
+            } else {
+                String::new()
+            };
             eprintln!(
                 "bound: {:.4} = largest emitted luminance {:.4} x (1 + 1.5 x {} bounces{media})",
                 b.luminance, b.emitted, b.max_depth
@@ -376,7 +385,11 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
     let mut cmds = quadray::vk::Commands::new(device)?;
     let gpu = GpuScene::for_render(device, &mut cmds, &scene)?;
     let im = &scene.image;
-    let variant = RenderVariant { caustics: false, volume: false, ..Default::default() };
+    let variant = if args.passes {
+        RenderVariant::default()
+    } else {
+        RenderVariant { caustics: false, volume: false, ..Default::default() }
+    };
     // Renders `s` (this scene, or its reference with another seed and spp).
     let render = |cmds: &mut quadray::vk::Commands, s: &Scene| {
         let mut progress = ProgressBar::new(false);

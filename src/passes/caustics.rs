@@ -93,8 +93,9 @@ pub struct CausticMap {
     pub report: CausticReport,
 }
 
-/// One grid per light and light sample, each aimed at the bounds of all the
-/// specular objects (one grid, so that no ray is counted twice where specular
+/// Two grids per light and light sample (one whose rays refract at glass, one
+/// whose rays reflect at the first glass they meet), each aimed at the
+/// bounds of all the specular objects (one grid, so that no ray is counted twice where specular
 /// objects nest, like water in a glass vessel). Positions are relative to
 /// `origin` (the GPU frame's), computed in f64; each grid has about `rays`
 /// rays. `None` when a light sits inside those bounds
@@ -134,6 +135,11 @@ pub fn emitters(scene: &Scene, origin: DVec3, max_specular: u32, rays: u32) -> O
             Light::Rect { .. } => {}
         }
     }
+    // Beside each grid, the same rays reflected at their first specular
+    // vertex when it is glass (caustic_trace.glsl): the light reflected off
+    // glass onto the floor and into the fog.
+    let reflected: Vec<GpuEmitter> = out.iter().map(|e| GpuEmitter { reflect_first: 1, ..*e }).collect();
+    out.extend(reflected);
     let mut first = 0u32;
     for e in &mut out {
         e.first_ray = first;

@@ -3,9 +3,11 @@
 //!
 //! - Energy: a point light above a glass ball over a floor. The caustic map,
 //!   integrated over the floor, holds the flux that enters the ball and
-//!   leaves it toward the floor: ∫ I (1 − F(θ))² dω over the ball's cone of
-//!   directions (both interfaces see the same angle θ in a ball, and the
-//!   caustic rays follow refraction only).
+//!   leaves it toward the floor, ∫ I (1 − F(θ))² dω over the ball's cone of
+//!   directions (both interfaces see the same angle θ in a ball; the
+//!   refracting grids), and the flux the ball reflects onto the part of the
+//!   floor in view, ∫ I F(θ) dω over the directions whose reflection lands
+//!   there (the reflecting grids).
 //! - Lens over a plane (`scenes/tests/lens.toml`): the render with the
 //!   caustic passes against a long brute-force render (FLIP).
 //! - A scene without specular objects runs no caustic pass.
@@ -38,6 +40,49 @@ fn predicted_flux(intensity: f64, d: f64, r: f64, eta: f64) -> f64 {
         .sum()
 }
 
+/// Flux that a ball of radius `r` centred `centre_height` above the floor
+/// reflects onto the floor square |x|, |z| <= `half` from a point light of
+/// intensity `intensity` at `light_height`: ∫ I F(θ) dω over the directions
+/// whose mirror reflection off the ball lands there (the floor's top face at
+/// y = 0.01; a ray reflected off a ball does not meet it again).
+fn predicted_reflected_flux(intensity: f64, light_height: f64, centre_height: f64, r: f64, eta: f64, half: f64) -> f64 {
+    use glam::DVec3;
+    let d = light_height - centre_height;
+    let psi_max = (r / d).asin();
+    let (steps, azimuths) = (20_000, 512);
+    let h = psi_max / steps as f64;
+    let light = DVec3::new(0.0, light_height, 0.0);
+    let centre = DVec3::new(0.0, centre_height, 0.0);
+    let mut flux = 0.0;
+    for k in 0..steps {
+        let psi = (k as f64 + 0.5) * h;
+        let solid_angle = 2.0 * std::f64::consts::PI * psi.sin() * h / azimuths as f64;
+        for j in 0..azimuths {
+            let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / azimuths as f64;
+            let dir = DVec3::new(psi.sin() * phi.cos(), -psi.cos(), psi.sin() * phi.sin());
+            // First intersection with the ball.
+            let oc = light - centre;
+            let b = oc.dot(dir);
+            let disc = b * b - (oc.length_squared() - r * r);
+            if disc < 0.0 {
+                continue;
+            }
+            let p = light + dir * (-b - disc.sqrt());
+            let n = (p - centre) / r;
+            let cos_i = -dir.dot(n);
+            let reflected = dir + 2.0 * cos_i * n;
+            if reflected.y >= 0.0 {
+                continue;
+            }
+            let land = p + reflected * ((p.y - 0.01) / -reflected.y);
+            if land.x.abs() <= half && land.z.abs() <= half {
+                flux += intensity * fresnel_dielectric(cos_i, eta) * solid_angle;
+            }
+        }
+    }
+    flux
+}
+
 #[test]
 fn glass_ball_deposits_the_flux_fresnel_predicts() {
     // The camera looks up at the floor from below: the floor is two-sided,
@@ -65,11 +110,13 @@ fn glass_ball_deposits_the_flux_fresnel_predicts() {
     let half = height * (0.5 * fov).to_radians().tan();
     let pixel_area = (2.0 * half / size as f64).powi(2);
     let deposited: f64 = report.irradiance.iter().map(|e| e[0] as f64 * pixel_area).sum();
-    let predicted = predicted_flux(100.0, 4.0, 0.5, 1.5);
+    let refracted = predicted_flux(100.0, 4.0, 0.5, 1.5);
+    let reflected = predicted_reflected_flux(100.0, 6.0, 2.0, 0.5, 1.5, half);
+    let predicted = refracted + reflected;
     let error = (deposited - predicted).abs() / predicted;
     println!(
-        "glass ball: {} rays, {} landed; deposited flux {deposited:.5} W, predicted {predicted:.5} W, \
-         relative error {error:.4} (bound {FLUX_TOLERANCE})",
+        "glass ball: {} rays, {} landed; deposited flux {deposited:.5} W, predicted {predicted:.5} W \
+         ({refracted:.5} refracted, {reflected:.5} reflected), relative error {error:.4} (bound {FLUX_TOLERANCE})",
         report.rays, report.landed
     );
     assert!(error < FLUX_TOLERANCE);
@@ -124,11 +171,18 @@ fn lens_in_fog_beams_match_the_brute_force_path_tracer() {
         "lens in fog: FLIP against brute force at 2048 spp: passes at 64 spp {:.4} (bound {LENS_FOG_FLIP_BOUND})",
         c.flip_fast
     );
-    // At equal GPU time brute force's error is below the passes' here
-    // (relMSE 0.119 against 0.187 when measured for issue 30; 0.07-0.14
-    // against 0.22 before): the beams do not pay yet (their kernels do not
-    // shrink: issue 30's note), so this test bounds the passes' error only.
     assert!(c.flip_fast < LENS_FOG_FLIP_BOUND);
+    // At equal GPU time (brute force gets EQUAL_TIME_MARGIN times as much)
+    // the passes' error is below brute force's since the caustic map also
+    // serves the floor seen through the fog (issue 30; before, 0.19 against
+    // 0.12). Issue 30's target, 0.5x, is not reached: see its note.
+    assert!(
+        c.rel_fast < c.rel_brute,
+        "passes relMSE {} not below brute force's {} at {:.2}x their GPU time",
+        c.rel_fast,
+        c.rel_brute,
+        c.brute.seconds / c.fast.seconds
+    );
 }
 
 /// The glass vessel of the paper's figure 2 at 256x192: the passes at 64 spp
@@ -147,7 +201,7 @@ fn glass_vessel_at_equal_time() {
     (scene.image.width, scene.image.height, scene.image.seed) = (256, 192, 1);
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results/caustics/vessel_reference.exr");
     let reference = quadray::output::read_render_exr(&path).unwrap().output;
-    let what = "results/caustics/vessel_reference.exr (brute force, 4096 spp)";
+    let what = "results/caustics/vessel_reference.exr (the passes at 2048 spp)";
     let c = common::equal_time("glass_vessel", "scenes/glass_vessel.toml", &scene, reference, what, 64);
     assert!(c.flip_fast < c.flip_brute, "FLIP {} not below brute force's {}", c.flip_fast, c.flip_brute);
 }
