@@ -95,6 +95,12 @@ fn default_lavapipe_threads() -> bool {
 }
 
 fn main() -> Result<()> {
+    // A closed pipe on stdout (`quadray compare a.exr b.exr | head -1`) ends
+    // the process quietly, as it does other command-line tools, instead of
+    // a panic in println!.
+    // SAFETY: called first, before any thread exists; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
     let set_threads = default_lavapipe_threads();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
