@@ -258,6 +258,21 @@ pub struct BruteForceComparison {
     pub rel_brute: f64,
 }
 
+impl BruteForceComparison {
+    /// Asserts what the passes are for: at equal time (brute force gets
+    /// EQUAL_TIME_MARGIN times their GPU time), a smaller relative MSE than
+    /// brute force's.
+    pub fn assert_passes_win(&self) {
+        assert!(
+            self.rel_fast < self.rel_brute,
+            "passes relMSE {} not below brute force's {} at {:.2}x their GPU time",
+            self.rel_fast,
+            self.rel_brute,
+            self.brute.seconds / self.fast.seconds
+        );
+    }
+}
+
 /// How much more GPU time than the passes' render the brute-force render
 /// gets. GPU times on lavapipe vary by 10 - 30 % between runs, so brute
 /// force is given half as much time again: a pass that still wins pays

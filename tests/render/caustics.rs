@@ -140,13 +140,7 @@ fn lens_over_plane_matches_the_brute_force_path_tracer() {
     assert!(c.flip_fast < LENS_FLIP_BOUND);
     // What the passes are for: at equal GPU time (brute force gets
     // EQUAL_TIME_MARGIN times as much), a smaller error than brute force's.
-    assert!(
-        c.rel_fast < c.rel_brute,
-        "caustic passes relMSE {} not below brute force's {} at {:.2}x their GPU time",
-        c.rel_fast,
-        c.rel_brute,
-        c.brute.seconds / c.fast.seconds
-    );
+    c.assert_passes_win();
 }
 
 #[test]
@@ -174,15 +168,10 @@ fn lens_in_fog_beams_match_the_brute_force_path_tracer() {
     assert!(c.flip_fast < LENS_FOG_FLIP_BOUND);
     // At equal GPU time (brute force gets EQUAL_TIME_MARGIN times as much)
     // the passes' error is below brute force's since the caustic map also
-    // serves the floor seen through the fog (issue 30; before, 0.19 against
-    // 0.12). Issue 30's target, 0.5x, is not reached: see its note.
-    assert!(
-        c.rel_fast < c.rel_brute,
-        "passes relMSE {} not below brute force's {} at {:.2}x their GPU time",
-        c.rel_fast,
-        c.rel_brute,
-        c.brute.seconds / c.fast.seconds
-    );
+    // serves the floor seen through the fog and the caustic rays reflect off
+    // glass too (issue 30: 0.47x measured at 1.41x the time, against issue
+    // 30's 0.5x; before, 0.19 against 0.12).
+    c.assert_passes_win();
 }
 
 /// The glass vessel of the paper's figure 2 at 256x192: the passes at 64 spp
