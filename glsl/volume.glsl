@@ -36,9 +36,6 @@ layout(set = 0, binding = BINDING_VOLUME, scalar) buffer Volume { float volume[]
 
 layout(push_constant, scalar) uniform PushBlock { VolumePush pc; };
 
-// Points per camera ray and light at which single scattering is estimated.
-const uint VOLUME_POINTS = 16u;
-
 // True when nothing blocks the segment from x to the pass's point on light
 // i, dist away along wi: from the map where the texel of x's direction and
 // its eight neighbours agree, else (a shadow's edge, or the map's folded

@@ -161,6 +161,9 @@ pub const BINDING_VOLUME: u32 = 14;
 /// the volume pass): per positional light, the distance from the pass's
 /// point on the light to the first surface in each direction.
 pub const BINDING_LIGHT_MAPS: u32 = 27;
+/// Points per camera ray and light at which the volume pass estimates single
+/// scattering (volume.glsl).
+pub const VOLUME_POINTS: u32 = 16;
 /// Descriptor binding of the volumetric-caustic radiance buffer (written by
 /// the caustic beam pass, read by the render pass).
 pub const BINDING_CAUSTIC_BEAMS: u32 = 15;

@@ -22,9 +22,7 @@ use crate::shader_interface::{BINDING_LIGHT_MAPS, BINDING_VOLUME, RENDER_GROUP, 
 use crate::vk::{Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, MemoryLocation};
 use crate::{shaders, RenderError};
 
-/// Points per camera ray and light at which the pass estimates single
-/// scattering (`VOLUME_POINTS` in `glsl/volume.glsl`).
-pub const VOLUME_POINTS: u32 = 16;
+pub use crate::shader_interface::VOLUME_POINTS;
 
 /// Texels on a side of a light map for a `width` x `height` image: the
 /// power of two nearest above the square root of the pixel count (a map
