@@ -36,8 +36,9 @@ vec3 sampleHg(float g, vec3 d, vec2 u) {
     return normalize(f[0] * (sinTheta * cos(phi)) + f[1] * (sinTheta * sin(phi)) + d * cosTheta);
 }
 
-// The halo strategy of a path's first scattering event in a medium (CPU
-// twin: sampling::phase::sample_halo, halo_pdf, HALO_SHARE): θ, the angle to
+// The halo strategy of a scattering event in a medium (nee.glsl,
+// sampleScatter; CPU twin: sampling::phase::sample_halo, halo_pdf,
+// HALO_SHARE, the largest share of the mixture): θ, the angle to
 // the axis a toward a light's centre, with density ∝ π − θ, φ uniform; its
 // solid-angle density (π − θ) / (π³ sin θ) has the shape of a small light's
 // single-scattering halo seen from the point (the airlight integral
