@@ -87,6 +87,8 @@ void traceCausticRay(uint i) {
             break;
         }
         if (!isDelta(mat) || speculars == e.maxSpecular) break;
+        // A ray of a reflecting grid at its first specular vertex.
+        bool reflectHere = e.reflectFirst != 0u && speculars == 0u;
         bool entering = dot(d, h.normal) < 0.0;
         vec3 n = entering ? h.normal : -h.normal;  // facing the ray
         float cosI = -dot(d, n);
@@ -102,7 +104,7 @@ void traceCausticRay(uint i) {
             }
             float etaRel = entering ? eta : 1.0 / eta;  // n_t / n_i
             float f = fresnelDielectric(cosI, etaRel);
-            if (e.reflectFirst != 0u && speculars == 0u) {
+            if (reflectHere) {
                 // The reflecting grid: reflection (weight F) at the first
                 // vertex, unless the glass reflects totally there (the
                 // refracting grid has that path).
@@ -123,7 +125,7 @@ void traceCausticRay(uint i) {
         } else {
             // The reflecting grid starts at glass only (the refracting grid
             // has the paths that start at a mirror).
-            if (e.reflectFirst != 0u && speculars == 0u) break;
+            if (reflectHere) break;
             d = reflected;
             flux *= mat.kind == MATERIAL_MIRROR ? v3(mat.albedo) : conductorFresnel(mat, cosI);
             event = 3u;

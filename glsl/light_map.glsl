@@ -42,6 +42,13 @@ vec3 octDecode(vec2 f) {
     return normalize(w);
 }
 
+// Point `i` of the n-point Hammersley set in [0, 1)² ((i + 1/2) / n, and
+// the radical inverse of i), shared by the light points and the volume
+// pass's camera rays.
+vec2 hammersley(uint i, uint n) {
+    return vec2((float(i) + 0.5) / float(max(n, 1u)), float(bitfieldReverse(i)) * 2.3283064e-10);
+}
+
 // A point on a light: where, its outward normal and the light's area (0
 // for a point light, whose `color` is an intensity).
 struct LightPoint {
@@ -54,7 +61,7 @@ struct LightPoint {
 LightPoint passLightPoint(uint i, uint pass, uint passes) {
     uint h = pcgHash(frame.seed ^ pcgHash(i + 0x51ed27u));
     vec2 shift = vec2(float(h >> 8), float(pcgHash(h) >> 8)) * (1.0 / 16777216.0);
-    vec2 u = fract(vec2((float(pass) + 0.5) / float(max(passes, 1u)), float(bitfieldReverse(pass)) * 2.3283064e-10) + shift);
+    vec2 u = fract(hammersley(pass, passes) + shift);
     Light l = lights[i];
     LightPoint y = LightPoint(v3(l.position), vec3(0.0), 0.0);
     if (l.kind == LIGHT_SPHERE) {

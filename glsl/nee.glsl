@@ -59,13 +59,15 @@ float haloShare(vec3 throughput, float etaScale) {
 // `share` (0: the phase function alone).
 float scatterPdf(Medium med, vec3 d, vec3 p, float share, vec3 wi) {
     float phase = hgPdf(med.anisotropy, dot(d, wi));
-    uint n = share > 0.0 ? haloLights() : 0u;
-    if (n == 0u) return phase;
+    if (!(share > 0.0)) return phase;
+    uint n = 0u;
     float halos = 0.0;
     for (uint i = 0u; i < frame.lightCount; ++i) { LOOP_EDGE();
-        if (haloLight(i)) halos += haloPdf(haloAxis(i, p), wi);
+        if (!haloLight(i)) continue;
+        halos += haloPdf(haloAxis(i, p), wi);
+        ++n;
     }
-    return (1.0 - share) * phase + share * halos / float(n);
+    return n == 0u ? phase : (1.0 - share) * phase + share * halos / float(n);
 }
 
 // The direction a path scattered at p in medium `med` while travelling along

@@ -6,6 +6,14 @@
 // Bounces after which Russian roulette may end a path.
 const uint RR_DEPTH = 3u;
 
+// The survival probability of Russian roulette at a vertex of bounce
+// `bounce` whose throughput is `throughput` (1: no roulette there; see
+// survives).
+float survival(vec3 throughput, float etaScale, uint bounce) {
+    if (bounce + 1u < RR_DEPTH) return 1.0;
+    return clamp(max(throughput.x, max(throughput.y, throughput.z)) * etaScale, 0.05, 1.0);
+}
+
 // Russian roulette after RR_DEPTH bounces: false when the path ends. The
 // survival probability is the throughput times `etaScale`, the product of
 // the η² factors that refractions divided the throughput by (radiance
@@ -14,13 +22,6 @@ const uint RR_DEPTH = 3u;
 // by that smaller probability would push the throughput above 1 when the
 // path leaves (a sample that gains energy). So the η-corrected throughput
 // never exceeds 1 (outliers.rs states the bound this gives).
-// The survival probability of Russian roulette at a vertex of bounce
-// `bounce` whose throughput is `throughput` (1: no roulette there).
-float survival(vec3 throughput, float etaScale, uint bounce) {
-    if (bounce + 1u < RR_DEPTH) return 1.0;
-    return clamp(max(throughput.x, max(throughput.y, throughput.z)) * etaScale, 0.05, 1.0);
-}
-
 bool survives(inout vec3 throughput, float etaScale, uint bounce, inout PathSampler rng) {
     float q = survival(throughput, etaScale, bounce);
     if (q >= 1.0) return true;

@@ -125,8 +125,7 @@ void surfaceVertex(inout PathState s, SceneHit h, Medium med, uint pixel, inout 
     record(EVENT_SURFACE, h.object, matIndex, transmits ? LOBE_TRANSMIT : LOBE_REFLECT, h.t, wo.z, bs.wi.z, bs.pdf, p,
            bs.weight, s.throughput * bs.weight, s.radiance);
     if (CAUSTICS_ENABLED != 0u) followCausticPath(s, mat, receiver, wo, bs.wi);
-    bool last = s.bounce + 1u == frame.maxDepth;
-    if (FILTER_MODE != FILTER_NONE && !last) {
+    if (FILTER_MODE != FILTER_NONE && !lastVertex(s)) {
         footprintBounce(s.foot, hitFoot, h, s.d, normalize(frameW * bs.wi), wo, bs.wi, mat.kind, mat.ior);
     }
     // Transmitted: update the stack of media, and the η² factor the weight

@@ -90,8 +90,7 @@ void volumePixel(uvec2 pix) {
     // pixel (Cranley–Patterson), taken to the pixel filter (the render
     // pass's Gaussian).
     uint pixelRng = seedRandom(pix, 0x5eedcafeu, frame.seed);
-    vec2 hammersley = vec2((float(pc.pass) + 0.5) / float(max(pc.passes, 1u)), float(bitfieldReverse(pc.pass)) * 2.3283064e-10);
-    vec2 u = fract(hammersley + rand2(pixelRng));
+    vec2 u = fract(hammersley(pc.pass, pc.passes) + rand2(pixelRng));
     vec3 d = cameraRay(vec2(pix) + 0.5 + gaussianPixelOffset(u, frame.pixelSigma));
     SceneHit h = traceScene(frame.eye, d, 0.0, 1e30);
     float tl;

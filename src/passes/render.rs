@@ -231,11 +231,7 @@ impl Renderer {
         )?;
         let caustics = caustic_map(device, gpu, scene, &frame, (width, height), variant, backend)?;
         let volume = if variant.volume && variant.shading == ShadingMode::Full && scene.needs_volume() {
-            let positional = (0u32..)
-                .zip(&scene.lights)
-                .filter(|(_, l)| !matches!(l, crate::scene::Light::Directional { .. }))
-                .map(|(i, _)| i)
-                .collect();
+            let positional = (0u32..).zip(&scene.lights).filter(|(_, l)| l.is_positional()).map(|(i, _)| i).collect();
             Some(VolumeLight::new(device, gpu, &frame, (width, height), backend, positional)?)
         } else {
             None

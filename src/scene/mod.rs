@@ -388,6 +388,13 @@ impl Light {
     pub fn emits_caustic_rays(&self) -> bool {
         !matches!(self, Light::Rect { .. })
     }
+
+    /// True for the lights with a position (point, sphere, rect): those the
+    /// volume pass and the equiangular estimates aim at (`positionalLight`
+    /// in glsl/light_queries.glsl).
+    pub fn is_positional(&self) -> bool {
+        !matches!(self, Light::Directional { .. })
+    }
 }
 
 impl Scene {
@@ -426,7 +433,7 @@ impl Scene {
     pub fn needs_volume(&self) -> bool {
         self.volume.samples > 0
             && self.fog.is_some_and(|f| f.density > 0.0)
-            && self.lights.iter().any(|l| !matches!(l, Light::Directional { .. }))
+            && self.lights.iter().any(Light::is_positional)
     }
 
     /// True when the caustic passes have work: caustic rays are enabled, and
