@@ -53,6 +53,7 @@ bool mediumEvent(inout PathState s, Medium med, float tl, uint segment, bool vol
         return true;
     }
     vec3 p = s.o + ts * s.d;
+    takeFeatures(s, v3(med.albedo), vec3(0.0));
     s.throughput *= v3(med.albedo);
     // Russian roulette before the direction is chosen: after it, a halo
     // direction's small weight (phase / mixture, for a segment that passes
@@ -106,6 +107,7 @@ void emitterFound(inout PathState s, uint which, float tl, bool afterVolumeScatt
     } else if (s.lastPdf > 0.0 && (light || environmentLit())) {
         w = powerHeuristic(s.lastPdf, lightOrEnvironmentPdf(which, s.lastPoint, s.d) / float(lightChoices()));
     }
+    takeFeatures(s, min(le, vec3(1.0)), vec3(0.0));
     bool coveredByCaustics = s.causticPath && s.causticSpeculars > 0u && light && lights[which].kind == LIGHT_SPHERE;
     // Single scattering on the camera ray's first segment toward a sphere or
     // rect light is the volume pass's.
@@ -128,6 +130,7 @@ void lastSegmentReached(inout PathState s, SceneHit h) {
         s.o = offsetOrigin(s.o + h.t * s.d, h.normal, s.d, h.offset);
         return;
     }
+    takeFeatures(s, v3(m.albedo), dot(h.normal, s.d) < 0.0 ? h.normal : -h.normal);
     s.radiance += s.throughput * v3(m.emission);
     record(EVENT_EMITTER, h.object, mi, NO_HIT, h.t, 0.0, 0.0, 1.0, s.o + h.t * s.d, s.throughput * v3(m.emission),
            s.throughput, s.radiance);

@@ -13,6 +13,18 @@ struct MediumScatter {
     float density;
 };
 
+// The denoiser's auxiliary features of one path (Intel Open Image
+// Denoise's albedo and normal images): taken at the path's first vertex that
+// is not a perfect specular one, so that a texture seen through glass or in
+// a mirror shows in them as it does in the image (Cycles' denoising passes
+// do the same), times the colour of the specular vertices on the way.
+struct DenoiseFeatures {
+    vec3 tint;  // the product of the specular vertices' colours so far
+    vec3 albedo;
+    vec3 normal;
+    bool open;  // true until the features are taken
+};
+
 // The state of a path between two of its segments.
 struct PathState {
     vec3 o;  // the next segment's origin
@@ -46,6 +58,7 @@ struct PathState {
     MediaStack media;
     // The footprint (ray cone or covariance, path_footprint.glsl).
     PathFootprint foot;
+    DenoiseFeatures features;
 };
 
 // A path leaving the camera at o along d; its footprint starts as its share
@@ -54,7 +67,17 @@ PathState pathStart(vec3 o, vec3 d) {
     float pixelAngle = 2.0 * length(frame.up) / float(frame.height);
     PathFootprint foot = footprintAtCamera(d, footprintSigma() * pixelAngle);
     return PathState(o, d, vec3(0.0), vec3(1.0), 1.0, 0.0, o, MediumScatter(vec4(0.0), vec3(0.0), 0.0, 0.0), false, 0u,
-                     false, false, 0u, 0u, true, emptyStack(), foot);
+                     false, false, 0u, 0u, true, emptyStack(), foot,
+                     DenoiseFeatures(vec3(1.0), vec3(0.0), vec3(0.0), true));
+}
+
+// Takes the denoiser's features at this vertex (albedo clamped to [0, 1],
+// as the denoiser expects), unless an earlier vertex gave them.
+void takeFeatures(inout PathState s, vec3 albedo, vec3 normal) {
+    if (!s.features.open) return;
+    s.features.albedo = s.features.tint * clamp(albedo, 0.0, 1.0);
+    s.features.normal = normal;
+    s.features.open = false;
 }
 
 // True at the path's last vertex (its continuation only looks for an

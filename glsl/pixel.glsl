@@ -4,6 +4,26 @@
 #ifndef PIXEL_GLSL
 #define PIXEL_GLSL
 
+// The AOVs of the ray through the pixel centre (depth, normal, albedo,
+// object), with no denoiser features yet.
+Aov pixelCentreAov(uvec2 pix) {
+    vec3 d = cameraRay(vec2(pix) + 0.5);
+    SceneHit h = traceScene(frame.eye, d, 0.0, 1e30);
+    Aov aov;
+    aov.depth = h.object == NO_HIT ? 1.0 / 0.0 : h.t;
+    vec3 n = h.normal;
+    aov.normal = float[3](n.x, n.y, n.z);
+    vec3 ns;
+    // The whole pixel filter, as the footprint of the centre ray.
+    float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * frame.pixelSigma;
+    vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, coneHitFootprint(d, h.normal, sigma), ns).albedo);
+    aov.albedo = float[3](alb.x, alb.y, alb.z);
+    aov.object = h.object;
+    aov.denoiseAlbedo = float[3](0.0, 0.0, 0.0);
+    aov.denoiseNormal = float[3](0.0, 0.0, 0.0);
+    return aov;
+}
+
 // One sample of the pixel at `local` in the tile (nothing outside it).
 void renderPixel(uvec2 local) {
     if (any(greaterThanEqual(local, pc.tileSize))) return;
@@ -11,27 +31,22 @@ void renderPixel(uvec2 local) {
     uint idx = pix.y * frame.width + pix.x;
     PathSampler rng = pathSampler(pix, pc.sampleIndex, frame.seed);
 
+    DenoiseFeatures f;
+    vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + 0.5 + cameraJitter(pix, pc.sampleIndex)), idx, rng, f);
+    // The pixel-centre ray's AOVs on the first sample; the denoiser's
+    // features summed over all samples (the host divides by their count),
+    // so that they are filtered by the pixel filter as the radiance is.
+    Aov aov;
     if (pc.writeAov != 0u) {
-        // AOVs from the ray through the pixel centre.
-        vec3 d = cameraRay(vec2(pix) + 0.5);
-        SceneHit h = traceScene(frame.eye, d, 0.0, 1e30);
-        Aov aov;
-        aov.depth = h.object == NO_HIT ? 1.0 / 0.0 : h.t;
-        vec3 n = h.normal;
-        aov.normal = float[3](n.x, n.y, n.z);
-        vec3 ns;
-        // The whole pixel filter, as the footprint of the centre ray.
-        float sigma = 2.0 * length(frame.up) / float(frame.height) * h.t * frame.pixelSigma;
-        vec3 alb = h.object == NO_HIT ? vec3(0.0) : v3(surfaceAt(h, d, coneHitFootprint(d, h.normal, sigma), ns).albedo);
-        aov.albedo = float[3](alb.x, alb.y, alb.z);
-        aov.object = h.object;
-        aovs[idx] = aov;
+        aov = pixelCentreAov(pix);
+    } else {
+        aov = aovs[idx];
     }
-
-    vec3 radiance = tracePath(frame.eye, cameraRay(vec2(pix) + 0.5 + cameraJitter(pix, pc.sampleIndex)), idx, rng);
-    // No NaN or Inf ever leaves the renderer: such a sample counts as black,
-    // and the accumulation's fourth channel counts only the finite samples,
-    // so that the host can report how many were dropped.
+    for (uint k = 0u; k < 3u; ++k) {
+        aov.denoiseAlbedo[k] += f.albedo[k];
+        aov.denoiseNormal[k] += f.normal[k];
+    }
+    aovs[idx] = aov;
     bool finite = !any(isnan(radiance)) && !any(isinf(radiance));
     ivec2 at = ivec2(pix);
     imageStore(accum, at, imageLoad(accum, at) + (finite ? vec4(radiance, 1.0) : vec4(0.0)));

@@ -28,7 +28,9 @@ layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light
 // rgb: summed radiance, a: sample count.
 layout(set = 0, binding = BINDING_ACCUM, rgba32f) uniform image2D accum;
 
-layout(set = 0, binding = BINDING_AOV, scalar) writeonly buffer Aovs { Aov aovs[]; };
+// The pixel-centre ray's AOVs (first sample) and the denoiser's feature
+// sums (every sample).
+layout(set = 0, binding = BINDING_AOV, scalar) buffer Aovs { Aov aovs[]; };
 
 // Texture maps with their mip chains (unused slots hold a white texel).
 layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTURES];
@@ -101,7 +103,7 @@ layout(constant_id = SPEC_SHADING_MODE) const uint SHADING_MODE = SHADING_FULL;
 // vertices of the kinds caustic_trace.comp follows. The path therefore
 // ignores a sphere light it finds after leaving that vertex through such
 // vertices only; every other path is estimated as usual.
-vec3 tracePath(vec3 o, vec3 d, uint pixel, inout PathSampler rng) {
+vec3 tracePath(vec3 o, vec3 d, uint pixel, inout PathSampler rng, out DenoiseFeatures features) {
     PathState s = pathStart(o, d);
     // One past the last segment: the emitter-only one after the last vertex
     // (the test shading modes end where they always did, without it).
@@ -143,6 +145,7 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout PathSampler rng) {
             surfaceVertex(s, h, med, pixel, rng);
         }
     }
+    features = s.features;
     return s.radiance;
 }
 

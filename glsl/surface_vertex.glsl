@@ -94,6 +94,7 @@ void surfaceVertex(inout PathState s, SceneHit h, Medium med, uint pixel, inout 
     if (mat.kind == MATERIAL_DIELECTRIC && (dot(ns, s.d) < 0.0) != entering) ns = h.normal;
     // Two-sided shading; dielectrics keep the outward normal to tell inside from outside.
     vec3 n = mat.kind == MATERIAL_DIELECTRIC || dot(h.normal, s.d) < 0.0 ? ns : -ns;
+    if (!isDelta(mat)) takeFeatures(s, v3(mat.albedo), n);
     mat3 frameW = frameAround(n);
     vec3 wo = transpose(frameW) * -s.d;
     uint mapPixel = CAUSTICS_ENABLED != 0u && mat.kind == MATERIAL_DIFFUSE ? causticPixel(h.object, p, s.bounce, pixel)
@@ -130,11 +131,16 @@ void surfaceVertex(inout PathState s, SceneHit h, Medium med, uint pixel, inout 
     }
     // Transmitted: update the stack of media, and the η² factor the weight
     // divided the throughput by (mat.ior is n_inside / n_outside).
+    float etaSquared = 1.0;
     if (mat.kind == MATERIAL_DIELECTRIC && transmits) {
         crossInterface(s.media, matIndex, entering);
         float etaRel = wo.z > 0.0 ? mat.ior : 1.0 / mat.ior;
-        s.etaScale *= etaRel * etaRel;
+        etaSquared = etaRel * etaRel;
+        s.etaScale *= etaSquared;
     }
+    // A specular vertex tints the features the path takes later (its weight
+    // without the η² of radiance compression: the colour of the glass).
+    if (isDelta(mat) && s.features.open) s.features.tint *= min(bs.weight * etaSquared, vec3(1.0));
     s.throughput *= bs.weight;
     // The albedo modes weigh no emitter against light sampling.
     s.lastPdf = SHADING_MODE == SHADING_FULL ? bs.pdf : 0.0;

@@ -5,8 +5,14 @@
 //! preset at the same image size. Every render is timed per pass with GPU
 //! timestamps, after an untimed warm-up (lavapipe compiles each shader at its
 //! first dispatch), and compared with the reference by FLIP and relative
-//! MSE. The report is written as JSON, Markdown, and a log-log plot of error
-//! against GPU time, with each render's PNG beside it.
+//! MSE. Where Intel Open Image Denoise is installed (`crate::denoise`), each
+//! preset's render is also denoised (high quality, with the albedo and normal
+//! features) and compared the same way, at the same spp and at the render's
+//! time plus the denoiser's (CPU wall time): denoising is biased, so its
+//! error does not fall with more samples the way a raw render's does. The
+//! report is written as JSON, Markdown, and a log-log plot of error against
+//! time (raw and denoised, one line each per scene), with each render's PNG
+//! beside it.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -36,6 +42,9 @@ pub enum BenchError {
     /// Comparing images failed.
     #[error(transparent)]
     Metric(#[from] MetricError),
+    /// The denoiser failed.
+    #[error(transparent)]
+    Denoise(#[from] crate::denoise::DenoiseError),
     /// The plot could not be written.
     #[error(transparent)]
     Plot(#[from] PlotError),
@@ -107,6 +116,21 @@ pub struct Row {
     pub flip: f64,
     /// Relative MSE against the reference.
     pub relative_mse: f64,
+    /// The same render denoised: what it cost and how far it is from the
+    /// reference (absent without the denoiser, and for the reference).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub denoised: Option<Denoised>,
+}
+
+/// A render denoised (Intel Open Image Denoise, high quality).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Denoised {
+    /// Wall time of the denoiser (on the CPU), s.
+    pub seconds: f64,
+    /// Mean FLIP against the reference.
+    pub flip: f64,
+    /// Relative MSE against the reference.
+    pub relative_mse: f64,
 }
 
 /// One scene's results.
@@ -162,6 +186,13 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
             total += w as u64 * h as u64 * preset_scene(&s.scene, p, config.size).image.spp as u64;
         }
     }
+    let mut denoiser = match crate::denoise::Denoiser::load() {
+        Ok(d) => Some(d),
+        Err(e) => {
+            log::warn!("{e}: the report has no denoised points");
+            None
+        }
+    };
     let mut bar = ProgressBar::new(config.progress);
     let mut done = 0u64;
 
@@ -209,7 +240,21 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
             let rel = relative_mse(&reference, &out)?;
             write_outputs(&out, &[(png(preset.name()), OutputKind::Png { exposure })])
                 .map_err(io(&png(preset.name())))?;
-            rows.push(row_of(preset, &scene, &out, wall, flip, rel));
+            let mut row = row_of(preset, &scene, &out, wall, flip, rel);
+            if let Some(d) = denoiser.as_mut() {
+                let start = Instant::now();
+                let image = crate::denoise::denoise_output(d, &out, crate::denoise::DenoiseQuality::High)?;
+                let seconds = start.elapsed().as_secs_f64();
+                let denoised = RenderOutput::from_radiance(out.width, out.height, image);
+                let name = format!("{}-denoised", preset.name());
+                write_outputs(&denoised, &[(png(&name), OutputKind::Png { exposure })]).map_err(io(&png(&name)))?;
+                row.denoised = Some(Denoised {
+                    seconds,
+                    flip: flip_mean(&reference, &denoised, exposure)?,
+                    relative_mse: relative_mse(&reference, &denoised)?,
+                });
+            }
+            rows.push(row);
         }
         reports.push(SceneReport {
             scene: s.name.clone(),
@@ -236,20 +281,28 @@ pub fn run(ctx: &Context, config: &Config) -> Result<Report, BenchError> {
 }
 
 /// Draws `bench.png` in `out_dir`: FLIP against GPU time, one line per scene
-/// through its presets.
+/// through its presets, and one through the same renders denoised (at
+/// their GPU time plus the denoiser's).
 pub fn write_plot(report: &Report, out_dir: &Path) -> Result<(), BenchError> {
-    let series: Vec<Series> = report
-        .scenes
-        .iter()
-        .map(|s| Series { label: s.scene.clone(), points: s.presets.iter().map(|r| (r.gpu_seconds, r.flip)).collect() })
-        .collect();
+    let mut series: Vec<Series> = Vec::new();
+    for s in &report.scenes {
+        series.push(Series {
+            label: s.scene.clone(),
+            points: s.presets.iter().map(|r| (r.gpu_seconds, r.flip)).collect(),
+        });
+        let denoised: Vec<(f64, f64)> =
+            s.presets.iter().filter_map(|r| r.denoised.as_ref().map(|d| (r.gpu_seconds + d.seconds, d.flip))).collect();
+        if !denoised.is_empty() {
+            series.push(Series { label: format!("{} denoised", s.scene), points: denoised });
+        }
+    }
     let first = report.scenes.first();
     let names: Vec<&str> = first.map(|s| s.presets.iter().map(|r| r.preset.as_str()).collect()).unwrap_or_default();
     let (w, h) = first.map_or((0, 0), |s| (s.width, s.height));
     write_log_log_plot(
         &out_dir.join("bench.png"),
         &format!("Presets ({}) against reference, {w}x{h}", names.join(", ")),
-        "GPU time (s)",
+        "GPU time (s); denoised lines: plus the denoiser's CPU time",
         "FLIP vs reference",
         &series,
         &[],
@@ -310,6 +363,7 @@ fn row_of(preset: Preset, scene: &Scene, out: &RenderOutput, wall: f64, flip: f6
         wall_seconds: wall,
         flip,
         relative_mse,
+        denoised: None,
     }
 }
 
@@ -374,11 +428,15 @@ pub fn markdown(report: &Report) -> String {
         );
         s +=
             "| preset | spp | depth | filter | caustic rays | volume rays/px | render (s) | caustics (s) | volume (s) \
-              | GPU total (s) | wall (s) | time vs reference | FLIP | rel. MSE |\n";
-        s += "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+              | GPU total (s) | wall (s) | time vs reference | FLIP | rel. MSE | denoise (s, CPU) | FLIP denoised \
+              | rel. MSE denoised |\n";
+        s += "|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for row in &sc.presets {
+            let denoised = row.denoised.as_ref().map_or("| – | – | – |".to_string(), |d| {
+                format!("| {:.3} | {:.4} | {:.4} |", d.seconds, d.flip, d.relative_mse)
+            });
             s += &format!(
-                "| {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.4} | {:.4} | {:.4} |\n",
+                "| {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.4} | {:.4} | {:.4} {denoised}\n",
                 row.preset,
                 row.spp,
                 row.max_depth,

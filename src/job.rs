@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 
 use crate::passes::checkpoint::{render_key, Checkpoint, CheckpointError};
 use crate::passes::{GpuScene, PixelBounds, RenderOutput, RenderVariant, Renderer};
-use crate::scene::Scene;
+use crate::scene::{ImageSettings, Scene};
 use crate::{vk, RenderError};
 
 /// How a job renders and when it stops.
@@ -83,13 +83,25 @@ fn describe(scene: &Scene, name: &str, bounds: PixelBounds) -> String {
 
 /// The checkpoint key of `scene` rendered with `variant` over `bounds`.
 pub fn job_key(scene: &Scene, variant: RenderVariant, bounds: PixelBounds) -> u64 {
-    render_key(scene, &(variant, bounds))
+    render_key(&*keyed(scene), &(variant, bounds))
 }
 
 /// The key the images of `scene` rendered with `variant` carry (any pixel
 /// bounds): tiles merge only with tiles of the same key.
 pub fn image_key(scene: &Scene, variant: RenderVariant) -> u64 {
-    render_key(scene, &variant)
+    render_key(&*keyed(scene), &variant)
+}
+
+/// `scene` with the settings that do not change the render (denoising,
+/// applied to the finished image) at their defaults, for the keys.
+fn keyed(scene: &Scene) -> std::borrow::Cow<'_, Scene> {
+    let plain = ImageSettings::minimal(0, 0);
+    if (scene.image.denoise, scene.image.denoise_quality) == (plain.denoise, plain.denoise_quality) {
+        return std::borrow::Cow::Borrowed(scene);
+    }
+    let mut s = scene.clone();
+    (s.image.denoise, s.image.denoise_quality) = (plain.denoise, plain.denoise_quality);
+    std::borrow::Cow::Owned(s)
 }
 
 /// The GPU state of a job: the scene uploaded and the passes built once,
@@ -197,4 +209,22 @@ pub fn read_resume(
     let Some(path) = &options.resume else { return Ok(None) };
     let key = job_key(scene, variant, options.bounds);
     Ok(Some(Checkpoint::read_for(path, key, &describe(scene, &options.scene_name, options.bounds))?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn denoising_does_not_change_the_keys() {
+        let scene = crate::scene::parse_scene(crate::scene::DEFAULT_SCENE, "default").unwrap();
+        let mut denoised = scene.clone();
+        (denoised.image.denoise, denoised.image.denoise_quality) = (true, crate::denoise::DenoiseQuality::Fast);
+        let (v, b) = (RenderVariant::default(), PixelBounds::full(4, 4));
+        assert_eq!(job_key(&scene, v, b), job_key(&denoised, v, b));
+        assert_eq!(image_key(&scene, v), image_key(&denoised, v));
+        let mut more = scene.clone();
+        more.image.spp += 1;
+        assert_ne!(job_key(&scene, v, b), job_key(&more, v, b));
+    }
 }

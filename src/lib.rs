@@ -13,6 +13,7 @@
 
 pub mod bench;
 pub mod covariance;
+pub mod denoise;
 pub mod farm;
 pub mod files;
 pub mod filter_bench;

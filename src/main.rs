@@ -57,6 +57,10 @@ enum Command {
     /// tiles of different scenes, settings or frames, unfinished tiles, gaps
     /// and overlaps, and then writes nothing.
     Merge(MergeArgs),
+    /// Denoise a render's EXR with Intel Open Image Denoise, guided by its
+    /// albedo and normal channels: writes PNG and EXR (RGB denoised, the raw
+    /// radiance kept as `noisy.RGB`). Needs the library (`make setup`).
+    Denoise(DenoiseArgs),
     /// Render on a Slurm cluster: a job array of one task per tile and frame
     /// (each idempotent and resumable), then a merge job (README.md, "Long
     /// renders and farms").
@@ -114,6 +118,7 @@ fn main() -> Result<()> {
         Some(Command::View(args)) => view(args),
         Some(Command::Throughput(args)) => throughput(args, set_threads),
         Some(Command::Merge(args)) => merge(args),
+        Some(Command::Denoise(args)) => denoise(args),
         Some(Command::Farm(cmd)) => farm(cmd),
         Some(Command::Devices(args)) => devices(args),
         None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),

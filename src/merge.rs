@@ -151,7 +151,11 @@ pub fn merge(tiles: &[(PathBuf, ExrFile)]) -> Result<(RenderOutput, Vec<(String,
             b.insert(&tile.output.max_sample, &mut out.max_sample, width);
         }
     }
-    Ok((out, first.metadata.clone()))
+    // The merged frame is the tiles' raw radiance: a tile denoised alone
+    // would show its edges (`quadray denoise` of the merged frame denoises
+    // it whole).
+    let metadata = first.metadata.iter().filter(|(k, _)| k != crate::output::METADATA_DENOISED).cloned().collect();
+    Ok((out, metadata))
 }
 
 #[cfg(test)]

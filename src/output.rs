@@ -26,6 +26,21 @@ pub enum ExrPrecision {
 pub const EXR_CHANNELS: [&str; 10] =
     ["R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G", "albedo.B"];
 
+/// The denoiser's features (`GpuAov::denoise_albedo`, `denoise_normal`:
+/// at the first non-specular vertex, averaged over the samples), written
+/// with every render that has AOVs; `quadray denoise` reads them.
+pub const EXR_DENOISE_CHANNELS: [&str; 6] = [
+    "denoise_albedo.R",
+    "denoise_albedo.G",
+    "denoise_albedo.B",
+    "denoise_normal.X",
+    "denoise_normal.Y",
+    "denoise_normal.Z",
+];
+
+/// The raw radiance of a denoised render (its RGB is the denoised image).
+pub const EXR_NOISY_CHANNELS: [&str; 3] = ["noisy.R", "noisy.G", "noisy.B"];
+
 /// The largest-sample AOV's EXR channels, written when the render has it:
 /// the luminance of the pixel's largest single sample and that sample's
 /// index.
@@ -80,15 +95,19 @@ pub const METADATA_FRAME: &str = "quadray.frame";
 /// Metadata name: the backend every tracing pass ran on (`ray-query` or
 /// `pipeline`).
 pub const METADATA_BACKEND: &str = "quadray.backend";
+/// Metadata name: how the image was denoised (library, version, quality,
+/// time), when it was: its RGB is the denoised image, `noisy.RGB` the raw.
+pub const METADATA_DENOISED: &str = "quadray.denoised";
 /// Metadata name: the hash of the scene and the settings
 /// (`passes::checkpoint::render_key`, 16 hex digits); tiles merge only
 /// with tiles of the same.
 pub const METADATA_SCENE_KEY: &str = "quadray.scene_key";
 
-/// 8-bit sRGB pixels: radiance · 2^exposure, clamped to [0, 1], encoded.
+/// 8-bit sRGB pixels: radiance (the denoised radiance where the render has
+/// it) · 2^exposure, clamped to [0, 1], encoded.
 pub fn tone_map(out: &RenderOutput, exposure: f32) -> Vec<u8> {
     let scale = exposure.exp2();
-    out.radiance
+    out.shown()
         .iter()
         .flat_map(|p| p.map(|v| (crate::texture::linear_to_srgb((v * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
         .collect()
@@ -118,9 +137,11 @@ fn write_png_to(out: &RenderOutput, exposure: f32, metadata: &[(String, String)]
     writer.finish().map_err(io::Error::other)
 }
 
-/// Writes the linear EXR (not atomically): RGB radiance and the AOVs `depth`
-/// (distance along the normalised pixel-centre ray, +inf on a miss),
-/// `normal.XYZ` (world space, zero on a miss) and `albedo.RGB`, and, when
+/// Writes the linear EXR (not atomically): RGB radiance (the denoised
+/// radiance when the render has it, the raw one then in `noisy.RGB`), the
+/// AOVs `depth` (distance along the normalised pixel-centre ray, +inf on a
+/// miss), `normal.XYZ` (world space, zero on a miss) and `albedo.RGB`, the
+/// denoiser's features `denoise_albedo.RGB` and `denoise_normal.XYZ`, and, when
 /// the render has it, the largest-sample AOV `max_sample.Y` (the luminance of
 /// the pixel's largest single sample) and `max_sample.index` (which sample
 /// it was; always 32-bit). The data window is the render's pixel bounds
@@ -133,10 +154,11 @@ pub fn write_exr_to(
     metadata: &[(String, String)],
     path: &Path,
 ) -> io::Result<()> {
+    let shown = out.shown();
     let columns: [Vec<f32>; 10] = [
-        out.radiance.iter().map(|p| p[0]).collect(),
-        out.radiance.iter().map(|p| p[1]).collect(),
-        out.radiance.iter().map(|p| p[2]).collect(),
+        shown.iter().map(|p| p[0]).collect(),
+        shown.iter().map(|p| p[1]).collect(),
+        shown.iter().map(|p| p[2]).collect(),
         out.aov.iter().map(|a| a.depth).collect(),
         out.aov.iter().map(|a| a.normal[0]).collect(),
         out.aov.iter().map(|a| a.normal[1]).collect(),
@@ -145,17 +167,23 @@ pub fn write_exr_to(
         out.aov.iter().map(|a| a.albedo[1]).collect(),
         out.aov.iter().map(|a| a.albedo[2]).collect(),
     ];
-    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = EXR_CHANNELS
-        .iter()
-        .zip(columns)
-        .map(|(name, values)| {
-            let samples = match precision {
-                ExrPrecision::Float => FlatSamples::F32(values),
-                ExrPrecision::Half => FlatSamples::F16(values.into_iter().map(f16::from_f32).collect()),
-            };
-            AnyChannel::new(*name, samples)
-        })
-        .collect();
+    let column = |values: Vec<f32>| match precision {
+        ExrPrecision::Float => FlatSamples::F32(values),
+        ExrPrecision::Half => FlatSamples::F16(values.into_iter().map(f16::from_f32).collect()),
+    };
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> =
+        EXR_CHANNELS.iter().zip(columns).map(|(name, values)| AnyChannel::new(*name, column(values))).collect();
+    if !out.aov.is_empty() {
+        for (k, name) in EXR_DENOISE_CHANNELS.iter().enumerate() {
+            let values = out.aov.iter().map(|a| if k < 3 { a.denoise_albedo[k] } else { a.denoise_normal[k - 3] });
+            channels.push(AnyChannel::new(*name, column(values.collect())));
+        }
+    }
+    if out.denoised.is_some() {
+        for (k, name) in EXR_NOISY_CHANNELS.iter().enumerate() {
+            channels.push(AnyChannel::new(*name, column(out.radiance.iter().map(|p| p[k]).collect())));
+        }
+    }
     if !out.max_sample.is_empty() {
         let [y, index] = EXR_MAX_SAMPLE_CHANNELS;
         channels.push(AnyChannel::new(y, FlatSamples::F32(out.max_sample.iter().map(|m| m[0]).collect())));
@@ -194,7 +222,9 @@ pub struct ExrFile {
     pub metadata: Vec<(String, String)>,
 }
 
-/// Reads an EXR written by [`write_exr_to`] (RGB and the AOV channels).
+/// Reads an EXR written by [`write_exr_to`] (RGB and the AOV channels):
+/// `radiance` is the raw radiance (`noisy.RGB` of a denoised render, whose
+/// RGB becomes `denoised`); the denoiser's features are zero when absent.
 pub fn read_render_exr(path: &Path) -> io::Result<ExrFile> {
     use exr::prelude::{read, ReadChannels as _, ReadLayers as _};
     let named = |e: String| io::Error::new(io::ErrorKind::InvalidData, format!("{}: {e}", path.display()));
@@ -214,15 +244,27 @@ pub fn read_render_exr(path: &Path) -> io::Result<ExrFile> {
     };
     let required = |name: &str| channel(name).ok_or_else(|| named(format!("no channel {name}")));
     let [r, g, b] = [required("R")?, required("G")?, required("B")?];
-    let radiance = (0..w * h).map(|i| [r[i], g[i], b[i]]).collect();
+    let rgb: Vec<[f32; 3]> = (0..w * h).map(|i| [r[i], g[i], b[i]]).collect();
+    // A denoised render's RGB is the denoised image; its radiance is `noisy`.
+    let noisy: Option<Vec<Vec<f32>>> = EXR_NOISY_CHANNELS.iter().map(|n| channel(n)).collect();
+    let (radiance, denoised) = match noisy {
+        Some(c) => ((0..w * h).map(|i| [c[0][i], c[1][i], c[2][i]]).collect(), Some(rgb)),
+        None => (rgb, None),
+    };
     let aov_channels: Option<Vec<Vec<f32>>> = EXR_CHANNELS[3..].iter().map(|n| channel(n)).collect();
+    let features: Option<Vec<Vec<f32>>> = EXR_DENOISE_CHANNELS.iter().map(|n| channel(n)).collect();
     let aov = aov_channels.map_or(Vec::new(), |c| {
         (0..w * h)
-            .map(|i| crate::passes::gpu::GpuAov {
-                depth: c[0][i],
-                normal: [c[1][i], c[2][i], c[3][i]],
-                albedo: [c[4][i], c[5][i], c[6][i]],
-                object: 0,
+            .map(|i| {
+                let f = |k: usize| features.as_ref().map_or(0.0, |f| f[k][i]);
+                crate::passes::gpu::GpuAov {
+                    depth: c[0][i],
+                    normal: [c[1][i], c[2][i], c[3][i]],
+                    albedo: [c[4][i], c[5][i], c[6][i]],
+                    object: 0,
+                    denoise_albedo: [f(0), f(1), f(2)],
+                    denoise_normal: [f(3), f(4), f(5)],
+                }
             })
             .collect()
     });
@@ -251,6 +293,7 @@ pub fn read_render_exr(path: &Path) -> io::Result<ExrFile> {
         _ => Vec::new(),
     };
     let mut output = RenderOutput::from_radiance(w as u32, h as u32, radiance);
+    output.denoised = denoised;
     output.bounds = bounds;
     output.frame_size = frame_size;
     output.aov = aov;

@@ -130,6 +130,21 @@ pub(crate) struct QualityArgs {
     /// `volume.samples`; 0 switches the volume pass off).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=65536))]
     pub(crate) volume_samples: Option<u32>,
+    /// Denoise the finished image with Intel Open Image Denoise (overrides
+    /// `image.denoise`; the `preview` and `interactive` presets denoise).
+    /// The PNG and the EXR's RGB show the denoised image; the EXR keeps the
+    /// raw radiance as `noisy.RGB`. Needs the library (`make setup`
+    /// installs it); without it the command fails before rendering.
+    #[arg(long, overrides_with = "no_denoise")]
+    pub(crate) denoise: bool,
+    /// Do not denoise (overrides `image.denoise` and the preset).
+    #[arg(long, overrides_with = "denoise")]
+    pub(crate) no_denoise: bool,
+    /// The denoiser's quality (overrides `image.denoise_quality`): `fast`,
+    /// `balanced` or `high` (the default: the albedo and normal images are
+    /// denoised first, OIDN's advice for features that carry noise).
+    #[arg(long)]
+    pub(crate) denoise_quality: Option<quadray::denoise::DenoiseQuality>,
 }
 
 impl QualityArgs {
@@ -145,7 +160,9 @@ impl QualityArgs {
         q.caustic_rays = self.caustic_rays.unwrap_or(q.caustic_rays);
         q.caustic_light_samples = self.caustic_light_samples.unwrap_or(q.caustic_light_samples);
         q.volume_samples = self.volume_samples.unwrap_or(q.volume_samples);
+        q.denoise = (q.denoise || self.denoise) && !self.no_denoise;
         scene.set_quality(q);
+        scene.image.denoise_quality = self.denoise_quality.unwrap_or(scene.image.denoise_quality);
     }
 }
 

@@ -1,4 +1,5 @@
-//! `quadray merge` and `quadray compare`: commands on rendered images.
+//! `quadray merge`, `quadray compare` and `quadray denoise`: commands on
+//! rendered images.
 
 use std::path::{Path, PathBuf};
 
@@ -26,6 +27,12 @@ pub(crate) fn merge(args: MergeArgs) -> Result<()> {
     let tiles =
         args.tiles.iter().map(|p| Ok((p.clone(), quadray::output::read_render_exr(p)?))).collect::<Result<Vec<_>>>()?;
     let (out, metadata) = quadray::merge::merge(&tiles)?;
+    if tiles.iter().any(|(_, t)| t.output.denoised.is_some()) {
+        eprintln!(
+            "the tiles' denoised images are left out (each was denoised alone): the merged frame is their raw \
+             radiance; `quadray denoise` denoises it whole"
+        );
+    }
     let exposure = metadata
         .iter()
         .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
@@ -35,6 +42,53 @@ pub(crate) fn merge(args: MergeArgs) -> Result<()> {
     write_outputs_with(&out, &files, &metadata)?;
     let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
     eprintln!("merged {} tiles into {} ({}x{}, {} spp)", tiles.len(), names.join(", "), out.width, out.height, out.spp);
+    Ok(())
+}
+
+#[derive(Parser, Debug)]
+pub(crate) struct DenoiseArgs {
+    /// A render's EXR (`quadray render`): its radiance (`noisy.RGB` where it
+    /// was denoised before, else RGB) and, where present, the denoiser's
+    /// albedo and normal channels.
+    pub(crate) input: PathBuf,
+    /// Output path, as `render -o`: `NAME.png`, `NAME.exr`, or a name
+    /// without those extensions for both. The EXR keeps every channel of
+    /// the input, with RGB denoised and the raw radiance as `noisy.RGB`.
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+    /// The denoiser's quality: `fast`, `balanced` or `high`.
+    #[arg(long, default_value_t = quadray::denoise::DenoiseQuality::High)]
+    pub(crate) quality: quadray::denoise::DenoiseQuality,
+    /// Write the EXR with 16-bit half floats instead of 32-bit floats.
+    #[arg(long)]
+    pub(crate) half: bool,
+}
+
+/// `quadray denoise`: an existing render denoised.
+pub(crate) fn denoise(args: DenoiseArgs) -> Result<()> {
+    let mut denoiser = quadray::denoise::Denoiser::load()?;
+    let quadray::output::ExrFile { mut output, mut metadata } = quadray::output::read_render_exr(&args.input)
+        .with_context(|| format!("cannot read {} as a render", args.input.display()))?;
+    if output.aov.is_empty() || output.aov.iter().all(|a| a.denoise_albedo == [0.0; 3]) {
+        eprintln!(
+            "{} has no denoiser features (denoise_albedo, denoise_normal): denoising the colour alone",
+            args.input.display()
+        );
+        output.aov.clear();
+    }
+    let done = super::render::denoise_into(&mut denoiser, &mut output, args.quality)?;
+    let exposure = metadata
+        .iter()
+        .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
+        .and_then(|(_, v)| v.parse().ok())
+        .unwrap_or(0.0);
+    metadata.retain(|(k, _)| k != quadray::output::METADATA_DENOISED);
+    metadata.push((quadray::output::METADATA_DENOISED.to_string(), done.clone()));
+    let files = output_files(&output_paths(&args.output), exposure, args.half);
+    write_outputs_with(&output, &files, &metadata)?;
+    let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
+    eprintln!("denoised: {done}");
+    eprintln!("wrote {}", names.join(", "));
     Ok(())
 }
 

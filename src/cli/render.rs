@@ -161,6 +161,8 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
              --tile, --frame or --frames"
         );
     }
+    // A missing denoiser is an error before any work, with nothing written.
+    let mut denoiser = if scene.image.denoise { Some(quadray::denoise::Denoiser::load()?) } else { None };
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
     let backend = args.backend.resolve(&ctx.device)?;
@@ -173,8 +175,9 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
     };
     let mut interrupted = false;
     if args.bench {
-        let out = bench(&ctx, &scene, backend)?;
-        write_render(&args, &ctx, &scene, variant, &outputs, None, &out, quadray::job::JobEnd::Complete)?;
+        let mut out = bench(&ctx, &scene, backend)?;
+        let end = quadray::job::JobEnd::Complete;
+        write_render(&args, &ctx, &scene, variant, &outputs, None, &mut out, end, denoiser.as_mut())?;
     } else {
         let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
         for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
@@ -211,7 +214,8 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
                 Some(f) => outputs.iter().map(|p| quadray::output::frame_path(p, f)).collect(),
                 None => outputs.clone(),
             };
-            write_render(&args, &ctx, &frame_scene, variant, &paths, frame, &result.output, result.end)?;
+            let mut out = result.output;
+            write_render(&args, &ctx, &frame_scene, variant, &paths, frame, &mut out, result.end, denoiser.as_mut())?;
             if result.end != quadray::job::JobEnd::Complete {
                 interrupted = result.end == quadray::job::JobEnd::Interrupted;
                 break;
@@ -228,8 +232,9 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Writes one render's (or frame's) files with their metadata, handles its
-/// checkpoint and prints what was done.
+/// Writes one render's (or frame's) files with their metadata, denoised
+/// first when the scene asks (`denoiser`), handles its checkpoint and
+/// prints what was done.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn write_render(
     args: &RenderArgs,
@@ -238,12 +243,17 @@ pub(crate) fn write_render(
     variant: quadray::passes::RenderVariant,
     outputs: &[PathBuf],
     frame: Option<u32>,
-    out: &quadray::passes::RenderOutput,
+    out: &mut quadray::passes::RenderOutput,
     end: quadray::job::JobEnd,
+    denoiser: Option<&mut quadray::denoise::Denoiser>,
 ) -> Result<()> {
     if ctx.counters().errors() > 0 {
         bail!("the validation layer reported {} error(s); no output written", ctx.counters().errors());
     }
+    let denoised = match denoiser {
+        Some(d) => Some(denoise_into(d, out, scene.image.denoise_quality)?),
+        None => None,
+    };
     let files = output_files(outputs, scene.image.exposure, args.half);
     let key = quadray::job::image_key(scene, variant);
     let mut metadata: Vec<(String, String)> = [
@@ -260,6 +270,9 @@ pub(crate) fn write_render(
     }
     if let Some(b) = out.backend {
         metadata.push((quadray::output::METADATA_BACKEND.to_string(), b.to_string()));
+    }
+    if let Some(d) = &denoised {
+        metadata.push((quadray::output::METADATA_DENOISED.to_string(), d.clone()));
     }
     write_outputs_with(out, &files, &metadata)?;
     let checkpoint = args.checkpoint.as_ref().or(args.resume.as_ref());
@@ -311,6 +324,9 @@ pub(crate) fn write_render(
             out.width as u64 * out.height as u64 * out.spp as u64
         );
     }
+    if let Some(d) = &denoised {
+        eprintln!("denoised: {d}");
+    }
     let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
     eprintln!(
         "wrote {} ({}x{}, {} spp, {:.2} s on {})",
@@ -322,6 +338,27 @@ pub(crate) fn write_render(
         ctx.device.name
     );
     Ok(())
+}
+
+/// Denoises `out` in place (its `denoised` image) and returns what was done,
+/// as the metadata and the message say it.
+pub(crate) fn denoise_into(
+    denoiser: &mut quadray::denoise::Denoiser,
+    out: &mut quadray::passes::RenderOutput,
+    quality: quadray::denoise::DenoiseQuality,
+) -> Result<String> {
+    let start = std::time::Instant::now();
+    let features = out.aov.len() == out.radiance.len();
+    out.denoised = Some(quadray::denoise::denoise_output(denoiser, out, quality)?);
+    let v = denoiser.version;
+    Ok(format!(
+        "Intel Open Image Denoise {}.{}.{}, {quality} quality, {}; {:.2} s",
+        v / 10000,
+        v / 100 % 100,
+        v % 100,
+        if features { "with the albedo and normal images" } else { "colour only" },
+        start.elapsed().as_secs_f64()
+    ))
 }
 
 /// The benchmark mode of `render --bench`; returns the full render.

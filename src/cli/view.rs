@@ -13,7 +13,7 @@ use quadray::scene::MAX_IMAGE_SIZE;
 #[command(after_help = concat!("Keys:\n", "mouse: left drag orbits, right drag turns the view, wheel dollies\n",
     "W A S D: fly forward, left, back, right    Q E: down, up    (arrow keys: orbit)\n",
     "F: next filtering mode    P: next preset    1 2 3 4: preview, interactive, final, reference\n",
-    "C: caustics on/off    V: volume on/off    R: reset camera\n",
+    "C: caustics on/off    V: volume on/off    N: denoise on/off    R: reset camera\n",
     "F12 or O: screenshot (PNG + EXR)    Esc: close"))]
 pub(crate) struct ViewArgs {
     /// Scene file (TOML). Omit it to view the built-in default scene.

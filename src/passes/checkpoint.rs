@@ -27,7 +27,7 @@ use super::film::{Accumulation, PixelBounds};
 use super::gpu::GpuAov;
 use crate::hash::Fnv1a;
 
-const MAGIC: &[u8; 8] = b"QRAYCKP1";
+const MAGIC: &[u8; 8] = b"QRAYCKP2";
 
 /// A checkpoint file's contents.
 #[derive(Clone, Debug, PartialEq)]
@@ -121,6 +121,9 @@ impl Checkpoint {
     /// Parses a file's bytes; `path` names it in errors.
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, CheckpointError> {
         let damaged = |why| CheckpointError::Damaged { path: path.into(), why };
+        if bytes.starts_with(b"QRAYCKP1") {
+            return Err(damaged("an older checkpoint format (1, before the denoiser's features): render afresh"));
+        }
         if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
             return Err(damaged("no checkpoint header"));
         }
@@ -204,7 +207,14 @@ mod tests {
 
     fn sample() -> Checkpoint {
         let bounds = PixelBounds { x0: 1, x1: 3, y0: 0, y1: 2 };
-        let aov = GpuAov { depth: 2.5, normal: [0.0, 1.0, 0.0], albedo: [0.5, 0.25, 0.125], object: 3 };
+        let aov = GpuAov {
+            depth: 2.5,
+            normal: [0.0, 1.0, 0.0],
+            albedo: [0.5, 0.25, 0.125],
+            object: 3,
+            denoise_albedo: [1.0, 0.5, 0.25],
+            denoise_normal: [0.0, 2.0, 0.0],
+        };
         Checkpoint {
             key: 0x1234_5678_9abc_def0,
             target_spp: 64,
@@ -251,5 +261,18 @@ mod tests {
         // 8 samples, 7 finite: one dropped.
         assert_eq!(out.dropped_samples, 1);
         assert_eq!((out.width, out.height), (2, 2));
+        // The denoiser's features too (sums over the samples); the
+        // pixel-centre AOVs are kept as they are.
+        assert_eq!(
+            (out.aov[1].denoise_albedo, out.aov[1].denoise_normal),
+            ([0.125, 0.0625, 0.03125], [0.0, 0.25, 0.0])
+        );
+        assert_eq!((out.aov[1].albedo, out.aov[1].depth), ([0.5, 0.25, 0.125], 2.5));
+    }
+
+    #[test]
+    fn an_older_format_is_named() {
+        let e = Checkpoint::from_bytes(b"QRAYCKP1 and the rest", Path::new("old.ckpt")).unwrap_err().to_string();
+        assert!(e.contains("an older checkpoint format"), "{e}");
     }
 }

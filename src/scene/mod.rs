@@ -16,7 +16,7 @@ pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE
 
 /// The longest path a scene may ask for (`image.max_depth`).
 pub const MAX_DEPTH: u32 = file::MAX_DEPTH as u32;
-pub use preset::{FilterMode, Preset, Quality};
+pub use preset::{DenoiseQuality, FilterMode, Preset, Quality};
 
 /// A pinhole camera.
 #[derive(Clone, Debug, PartialEq)]
@@ -114,6 +114,12 @@ pub struct ImageSettings {
     /// The quality preset the settings started from, if any (the scene
     /// file's or the command line's; explicit settings may override parts).
     pub preset: Option<Preset>,
+    /// Denoise the finished image (Intel Open Image Denoise; the raw
+    /// radiance is kept in the EXR). Not part of the render's key: a
+    /// checkpoint or tile of the same render with or without it matches.
+    pub denoise: bool,
+    /// The denoiser's quality.
+    pub denoise_quality: DenoiseQuality,
 }
 
 impl ImageSettings {
@@ -131,6 +137,8 @@ impl ImageSettings {
             max_depth: 1,
             filter: FilterMode::default(),
             preset: None,
+            denoise: false,
+            denoise_quality: DenoiseQuality::default(),
         }
     }
 }

@@ -1,12 +1,13 @@
 //! Quality presets: named sets of the settings that trade speed for accuracy.
 //!
-//! A scene's quality is the six settings of [`Quality`]: samples per pixel,
-//! path depth, texture filtering, caustic rays, caustic light samples and
-//! volume samples. A preset sets all six at once; a scene file picks one with
-//! `[image] preset = "final"`, and its own explicit keys (`spp`, `max_depth`,
-//! `filter`, `[caustics]`, `[volume]`) then override single settings. On the
-//! command line, `--preset` replaces all six (the scene file's keys
-//! included), and the individual flags (`--spp`, `--filter`, …) override it.
+//! A scene's quality is the seven settings of [`Quality`]: samples per
+//! pixel, path depth, texture filtering, caustic rays, caustic light samples,
+//! volume samples and denoising. A preset sets all seven at once; a scene
+//! file picks one with `[image] preset = "final"`, and its own explicit keys
+//! (`spp`, `max_depth`, `filter`, `denoise`, `[caustics]`, `[volume]`) then
+//! override single settings. On the command line, `--preset` replaces all
+//! seven (the scene file's keys included), and the individual flags
+//! (`--spp`, `--filter`, `--denoise`, …) override it.
 //!
 //! `quadray bench` measures what each preset costs and how far its image is
 //! from `reference` (results/bench/README.md).
@@ -74,6 +75,46 @@ impl FromStr for FilterMode {
     }
 }
 
+/// The denoiser's quality (Intel Open Image Denoise's network,
+/// `crate::denoise`): speed against fidelity.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DenoiseQuality {
+    /// The fastest network, for previews and the viewer.
+    Fast,
+    /// Between the two.
+    Balanced,
+    /// The best network; about 2-6x the time of `fast`.
+    #[default]
+    High,
+}
+
+impl DenoiseQuality {
+    /// Every quality, fastest first.
+    pub const ALL: [DenoiseQuality; 3] = [Self::Fast, Self::Balanced, Self::High];
+
+    /// The scene-file and command-line spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fast => "fast",
+            Self::Balanced => "balanced",
+            Self::High => "high",
+        }
+    }
+}
+
+impl fmt::Display for DenoiseQuality {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for DenoiseQuality {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        from_name(&Self::ALL, Self::name, "denoise quality", s)
+    }
+}
+
 /// The value of `all` whose `name` is `s`, or an error that names `what`
 /// and lists every name (the `FromStr` of the named settings).
 pub(crate) fn from_name<T: Copy>(all: &[T], name: fn(T) -> &'static str, what: &str, s: &str) -> Result<T, String> {
@@ -100,6 +141,9 @@ pub struct Quality {
     /// Volume-pass camera rays per pixel and sample; 0 leaves the fog's
     /// single scattering to the path tracer (`[volume] samples`).
     pub volume_samples: u32,
+    /// Denoise the finished image with Intel Open Image Denoise (`[image]
+    /// denoise`; `crate::denoise`).
+    pub denoise: bool,
 }
 
 /// Without a preset, a scene file's missing keys take these: 16 spp, depth
@@ -114,6 +158,7 @@ impl Default for Quality {
             caustic_rays: super::DEFAULT_CAUSTIC_RAYS,
             caustic_light_samples: super::DEFAULT_CAUSTIC_LIGHT_SAMPLES,
             volume_samples: super::DEFAULT_VOLUME_SAMPLES,
+            denoise: false,
         }
     }
 }
@@ -122,12 +167,13 @@ impl Default for Quality {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Preset {
     /// A first look in about a second: 1 spp, 3 bounces (the fewest that
-    /// still show caustics), prefiltered textures, few caustic rays.
+    /// still show caustics), prefiltered textures, few caustic rays,
+    /// denoised.
     Preview,
-    /// The viewer's default: 4 spp per refresh, 4 bounces.
+    /// The viewer's default: 4 spp per refresh, 4 bounces, denoised.
     Interactive,
     /// An image to keep: 64 spp, 8 bounces, 256k caustic rays from 8 points
-    /// of each sphere light.
+    /// of each sphere light; not denoised unless asked (`--denoise`).
     Final,
     /// The ground truth the others are measured against: 1024 spp, 16
     /// bounces, no prefiltering, and no caustic or volume pass (the path
@@ -149,6 +195,7 @@ impl Preset {
                 caustic_rays: 16_384,
                 caustic_light_samples: 1,
                 volume_samples: 1,
+                denoise: true,
             },
             Self::Interactive => Quality {
                 spp: 4,
@@ -157,6 +204,7 @@ impl Preset {
                 caustic_rays: 65_536,
                 caustic_light_samples: 4,
                 volume_samples: 1,
+                denoise: true,
             },
             Self::Final => Quality {
                 spp: 64,
@@ -165,6 +213,7 @@ impl Preset {
                 caustic_rays: 262_144,
                 caustic_light_samples: 8,
                 volume_samples: 2,
+                denoise: false,
             },
             Self::Reference => Quality {
                 spp: 1024,
@@ -173,6 +222,7 @@ impl Preset {
                 caustic_rays: 0,
                 caustic_light_samples: 1,
                 volume_samples: 0,
+                denoise: false,
             },
         }
     }
@@ -217,6 +267,7 @@ impl Scene {
             caustic_rays: self.caustics.rays,
             caustic_light_samples: self.caustics.light_samples,
             volume_samples: self.volume.samples,
+            denoise: self.image.denoise,
         }
     }
 
@@ -228,6 +279,7 @@ impl Scene {
         self.caustics.rays = q.caustic_rays;
         self.caustics.light_samples = q.caustic_light_samples;
         self.volume.samples = q.volume_samples;
+        self.image.denoise = q.denoise;
     }
 
     /// Replaces all quality settings with those of `preset`, and records it.
@@ -250,6 +302,10 @@ mod tests {
             assert_eq!(m.name().parse::<FilterMode>().unwrap(), m);
         }
         assert!("fast".parse::<Preset>().unwrap_err().contains("preview, interactive"));
+        for q in DenoiseQuality::ALL {
+            assert_eq!(q.name().parse::<DenoiseQuality>(), Ok(q));
+        }
+        assert!("best".parse::<DenoiseQuality>().unwrap_err().contains("fast, balanced, high"));
     }
 
     #[test]
@@ -263,6 +319,8 @@ mod tests {
             let q = p.quality();
             assert_eq!(p == Preset::Reference, q.caustic_rays == 0 && q.volume_samples == 0);
             assert_eq!(p == Preset::Reference, q.filter == FilterMode::None);
+            // The quick presets denoise; an image to keep or compare does not.
+            assert_eq!(q.denoise, matches!(p, Preset::Preview | Preset::Interactive));
         }
     }
 

@@ -18,6 +18,10 @@ pub enum Action {
     ToggleCaustics,
     /// Volume pass on or off.
     ToggleVolume,
+    /// Denoising on or off (Intel Open Image Denoise: the view shows the
+    /// denoised image once it has two samples, and denoises again each time
+    /// its samples double, and at the last).
+    ToggleDenoise,
     /// Save the frame on screen as PNG (the displayed pixels) and EXR (its
     /// linear radiance), under the given name or a numbered one.
     Screenshot(Option<String>),
@@ -57,7 +61,7 @@ pub const KEY_HELP: &str = "\
 mouse: left drag orbits, right drag turns the view, wheel dollies
 W A S D: fly forward, left, back, right    Q E: down, up    (arrow keys: orbit)
 F: next filtering mode    P: next preset    1 2 3 4: preview, interactive, final, reference
-C: caustics on/off    V: volume on/off    R: reset camera
+C: caustics on/off    V: volume on/off    N: denoise on/off    R: reset camera
 F12 or O: screenshot (PNG + EXR)    Esc: close";
 
 /// The action of a pressed key (winit's logical key, lower-cased).
@@ -71,6 +75,7 @@ pub fn key_action(key: &str) -> Option<Action> {
         "4" => Action::SetPreset(Preset::Reference),
         "c" => Action::ToggleCaustics,
         "v" => Action::ToggleVolume,
+        "n" => Action::ToggleDenoise,
         "r" => Action::ResetCamera,
         "o" | "f12" => Action::Screenshot(None),
         "w" => Action::Fly(1.0, 0.0, 0.0),
@@ -114,7 +119,7 @@ steps separated by `;` or new lines:
   frames N          until N more frames are presented
   screenshot [NAME] save NAME.png and NAME.exr in the screenshot folder
   capture NAME      save the window as the X server shows it, NAME.png
-  key K             press key K (f, p, 1-4, c, v, r, w, a, s, d, q, e, arrowleft, ...)
+  key K             press key K (f, p, 1-4, c, v, n, r, w, a, s, d, q, e, arrowleft, ...)
   orbit YAW PITCH   orbit by these angles (degrees)
   resize WxH        ask for a window of W x H pixels
   minimize | restore
@@ -213,7 +218,8 @@ mod tests {
 
     #[test]
     fn every_bound_key_has_an_action() {
-        for k in ["f", "p", "1", "2", "3", "4", "c", "v", "r", "o", "f12", "w", "a", "s", "d", "q", "e", "escape"] {
+        for k in ["f", "p", "1", "2", "3", "4", "c", "v", "n", "r", "o", "f12", "w", "a", "s", "d", "q", "e", "escape"]
+        {
             assert!(key_action(k).is_some(), "{k}");
         }
     }

@@ -6,7 +6,10 @@
 //! spp, or `--max-spp`), and starts again whenever the camera or a setting
 //! changes. Moving the camera keeps the render pipelines (lavapipe compiles
 //! a pipeline at its first dispatch); a new size, preset, filtering mode or
-//! pass toggle builds new ones.
+//! pass toggle builds new ones. With denoising on (`N`; the `preview` and
+//! `interactive` presets), the view shows the image denoised by Intel Open
+//! Image Denoise once it has two samples, keeps it on screen while samples
+//! are added, and denoises again when they have doubled and at the last.
 //!
 //! The keys are in [`actions::KEY_HELP`]; the same actions can be scripted
 //! ([`actions::SCRIPT_HELP`]), which is how the tests drive the window under
@@ -28,6 +31,7 @@ use winit::keyboard::{Key, NamedKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
+use crate::denoise::Denoiser;
 use crate::output::{tone_map, write_outputs, ExrPrecision, OutputKind};
 use crate::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
 use crate::scene::{Preset, Scene};
@@ -145,6 +149,13 @@ struct App {
     cursor: (f64, f64),
     /// A size asked for and not yet reported by the window system.
     resize_pending: bool,
+    /// The denoiser, loaded when the view first needs it; the reason it
+    /// could not be, after which the view shows raw samples.
+    denoiser: Option<Result<Denoiser, String>>,
+    /// Samples of the denoised frame on screen (0: none of this view).
+    denoised_spp: u32,
+    /// Show the current samples again (denoising was switched).
+    refresh: bool,
     error: Option<ViewerError>,
 }
 
@@ -169,6 +180,9 @@ impl App {
             drag: None,
             cursor: (0.0, 0.0),
             resize_pending: false,
+            denoiser: None,
+            denoised_spp: 0,
+            refresh: false,
             error: None,
             config,
         }
@@ -227,6 +241,11 @@ impl App {
                 self.variant.volume = !self.variant.volume;
                 self.dirty.renderer = true;
             }
+            Action::ToggleDenoise => {
+                // The samples stay; only what is shown of them changes.
+                self.scene.image.denoise = !self.scene.image.denoise;
+                self.refresh = true;
+            }
             Action::Screenshot(name) => {
                 if let Err(e) = self.screenshot(name) {
                     self.fail(event_loop, e);
@@ -277,9 +296,11 @@ impl App {
     fn set_preset(&mut self, preset: Preset) {
         let (w, h, seed, exposure) =
             (self.scene.image.width, self.scene.image.height, self.scene.image.seed, self.scene.image.exposure);
+        let quality = self.scene.image.denoise_quality;
         self.scene.apply_preset(preset);
         (self.scene.image.width, self.scene.image.height, self.scene.image.seed, self.scene.image.exposure) =
             (w, h, seed, exposure);
+        self.scene.image.denoise_quality = quality;
         self.dirty.renderer = true;
     }
 
@@ -362,12 +383,45 @@ impl App {
             self.dirty.camera = false;
             self.shown = None;
         }
-        if renderer.samples() < target {
+        let fresh = if renderer.samples() < target {
             renderer.add_samples(&mut g.cmds, 1, &mut |_, _| {})?;
-            let out = renderer.output(&mut g.cmds)?;
-            let rgb = tone_map(&out, self.scene.image.exposure);
-            let rgba = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
-            self.shown = Some((out, rgba));
+            Some(renderer.output(&mut g.cmds)?)
+        } else if self.refresh && renderer.samples() > 0 {
+            Some(renderer.output(&mut g.cmds)?)
+        } else {
+            None
+        };
+        self.refresh = false;
+        if self.shown.is_none() {
+            self.denoised_spp = 0;
+        }
+        if let Some(mut out) = fresh {
+            let showing_denoised = self.shown.as_ref().is_some_and(|(o, _)| o.denoised.is_some());
+            // Denoised once the view rests (two samples, or all it will
+            // get), then again each time its samples double.
+            let due = !showing_denoised || out.spp >= target || out.spp >= 2 * self.denoised_spp.max(1);
+            let denoise = self.scene.image.denoise && (out.spp >= 2 || out.spp >= target);
+            if denoise && due {
+                if let Some(d) = Self::denoiser(&mut self.denoiser) {
+                    match crate::denoise::denoise_output(d, &out, self.scene.image.denoise_quality) {
+                        Ok(image) => {
+                            out.denoised = Some(image);
+                            self.denoised_spp = out.spp;
+                        }
+                        Err(e) => {
+                            log::warn!("{e}; showing the samples without denoising");
+                            self.denoiser = Some(Err(e.to_string()));
+                        }
+                    }
+                }
+            }
+            // While denoising, the last denoised frame of this view stays on
+            // screen until the next is due.
+            if out.denoised.is_some() || !(self.scene.image.denoise && showing_denoised) {
+                let rgb = tone_map(&out, self.scene.image.exposure);
+                let rgba = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
+                self.shown = Some((out, rgba));
+            }
         }
         let Some((_, rgba)) = &self.shown else { return Ok(()) };
         let swapchain = g.swapchain.as_mut().expect("checked above");
@@ -376,19 +430,40 @@ impl App {
         }
         self.frames += 1;
         self.frame_ms = start.elapsed().as_secs_f64() * 1e3;
+        let denoised = match (&self.denoiser, self.scene.image.denoise) {
+            (_, false) => "off".to_string(),
+            (Some(Err(_)), true) => "unavailable".to_string(),
+            _ => match &self.shown {
+                Some((o, _)) if o.denoised.is_some() => format!("at {} spp", o.spp),
+                _ => "on".to_string(),
+            },
+        };
         let title = format!(
-            "quadray — {} — {} — filter {} — caustics {} — volume {} — {}/{} spp — {:.0} ms/frame",
+            "quadray — {} — {} — filter {} — caustics {} — volume {} — denoise {} — {}/{} spp — {:.0} ms/frame",
             self.config.name,
             self.scene.image.preset.map_or("custom", Preset::name),
             self.scene.image.filter,
             if self.variant.caustics { "on" } else { "off" },
             if self.variant.volume { "on" } else { "off" },
+            denoised,
             renderer.samples(),
             target,
             self.frame_ms
         );
         g.window.set_title(&title);
         Ok(())
+    }
+
+    /// The denoiser, loaded at the first call; `None` when the library is
+    /// missing (said once, as a warning).
+    fn denoiser(slot: &mut Option<Result<Denoiser, String>>) -> Option<&mut Denoiser> {
+        let loaded = slot.get_or_insert_with(|| {
+            Denoiser::load().map_err(|e| {
+                log::warn!("{e}; the view shows the samples without denoising");
+                e.to_string()
+            })
+        });
+        loaded.as_mut().ok()
     }
 
     /// True while the view still has samples to add or changes to show.
@@ -398,7 +473,7 @@ impl App {
             return false; // minimised: wait for the window to come back
         }
         let converged = g.renderer.as_ref().is_some_and(|r| r.samples() >= self.target_spp());
-        self.dirty.renderer || self.dirty.camera || self.dirty.swapchain || !converged
+        self.dirty.renderer || self.dirty.camera || self.dirty.swapchain || self.refresh || !converged
     }
 
     /// Runs script steps until one has to wait.

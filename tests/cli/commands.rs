@@ -237,9 +237,14 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     assert_eq!(exr.size(), (WIDTH, HEIGHT));
     let mut want = quadray::output::EXR_CHANNELS.map(String::from).to_vec();
     want.extend(quadray::output::EXR_MAX_SAMPLE_CHANNELS.map(String::from));
+    want.extend(quadray::output::EXR_DENOISE_CHANNELS.map(String::from));
     want.sort();
     assert_eq!(exr.names(), want);
-    for name in quadray::output::EXR_CHANNELS.iter().chain(&quadray::output::EXR_MAX_SAMPLE_CHANNELS) {
+    for name in quadray::output::EXR_CHANNELS
+        .iter()
+        .chain(&quadray::output::EXR_MAX_SAMPLE_CHANNELS)
+        .chain(&quadray::output::EXR_DENOISE_CHANNELS)
+    {
         assert!(matches!(exr.samples(name), FlatSamples::F32(_)), "{name} should hold 32-bit floats");
     }
     let depth = exr.channel("depth");
@@ -253,6 +258,10 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     let normal = exr.vec3(["normal.X", "normal.Y", "normal.Z"]);
     let albedo = exr.vec3(["albedo.R", "albedo.G", "albedo.B"]);
     let rgb = exr.vec3(["R", "G", "B"]);
+    let [da, db, dc, dx, dy, dz] = quadray::output::EXR_DENOISE_CHANNELS;
+    let feature_albedo = exr.vec3([da, db, dc]);
+    let feature_normal = exr.vec3([dx, dy, dz]);
+    let mut max_feature_error = 0f64;
 
     // A pixel covers about 2·tan(15°)·5/30 ≈ 0.09 at the sphere; radiance
     // (jittered over the pixel filter) is checked only where the pixel's
@@ -298,7 +307,15 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                         for k in 0..3 {
                             // f32 accumulation of 256 samples rounds at ~1e-4 relative.
                             assert!((rgb[i][k] - BACKGROUND[k]).abs() < 2e-4, "{at}: background {:?}", rgb[i]);
+                            // The denoiser's features of the environment:
+                            // its colour (below 1), no normal.
+                            assert!(
+                                (feature_albedo[i][k] - BACKGROUND[k]).abs() < 2e-4,
+                                "{at}: {:?}",
+                                feature_albedo[i]
+                            );
                         }
+                        assert_eq!(feature_normal[i], [0.0; 3], "{at}: the denoiser's normal of the environment");
                     }
                 }
                 Some((t, n)) => {
@@ -312,6 +329,25 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
                     assert!(nerr < 1e-4, "{at}: normal {got:?} expected {n:?}");
                     for k in 0..3 {
                         assert!((albedo[i][k] - ALBEDO[k]).abs() < 1e-6, "{at}: albedo {:?}", albedo[i]);
+                    }
+                    // The denoiser's features: averages over the jittered
+                    // samples. Where every sample hits the sphere (3 px
+                    // inside its silhouette), the albedo; the mean of the
+                    // normals over the Gaussian jitter (σ = 0.5 px) is the
+                    // centre's to second order: the normal's z bends by
+                    // 1 / (1 − d²)^{3/2} ≤ 4.7 per unit² up to d = 0.8, which
+                    // moves the mean by ½ · 4.7 · (0.5 px · 0.089)² < 0.005.
+                    if e.miss_distance < 1.0 - 3.0 * pixel {
+                        for k in 0..3 {
+                            let err = (feature_albedo[i][k] - ALBEDO[k]).abs();
+                            assert!(err < 2e-4, "{at}: the denoiser's albedo {:?}", feature_albedo[i]);
+                        }
+                    }
+                    if e.miss_distance < 0.8 {
+                        let got = feature_normal[i].map(|v| v as f64);
+                        let ferr = sub(got, n).iter().fold(0f64, |m, v| m.max(v.abs()));
+                        max_feature_error = max_feature_error.max(ferr);
+                        assert!(ferr < 0.01, "{at}: the denoiser's normal {got:?}, expected {n:?}");
                     }
                     // Lambert: albedo / π · I cos θ / r² from the point light,
                     // where the whole pixel sees the sphere's front, plus the
@@ -374,7 +410,8 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     }
     println!(
         "{hits} hits ({lit} lit, {dark} dark), {misses} misses; max depth error {max_depth_error:.2e}, \
-         max normal error {max_normal_error:.2e}, max Lambert error {:.1}% (lit), {:.1}% (environment only)",
+         max normal error {max_normal_error:.2e} (the denoiser's mean normal {max_feature_error:.2e}), \
+         max Lambert error {:.1}% (lit), {:.1}% (environment only)",
         100.0 * max_lit_error,
         100.0 * max_dark_error
     );
@@ -747,4 +784,81 @@ fn a_device_with_neither_extension_is_refused_with_what_it_lacks() {
     assert!(devices.status.success());
     let text = String::from_utf8_lossy(&devices.stdout);
     assert!(text.contains("auto: no device fits"), "{text}");
+}
+
+/// `--denoise`: the PNG and the EXR's RGB are the denoised image, the EXR
+/// keeps the raw radiance as `noisy.RGB` beside the denoiser's features and
+/// says how it was denoised; `quadray denoise` of that EXR gives the same
+/// image again. Without the library (`QUADRAY_OIDN_LIB` naming a file that
+/// is not there) `render --denoise`, a denoising preset and `quadray
+/// denoise` fail before any work, say how to get it, and write nothing.
+#[test]
+fn denoise_keeps_the_raw_image_and_without_the_library_writes_nothing() {
+    let outdir = tempfile::tempdir().unwrap();
+    let dir = outdir.path();
+    let out = dir.join("d");
+    let small = ["--width", "48", "--height", "36", "--spp", "2"];
+    let mut args = vec!["render", "-o", out.to_str().unwrap(), "--denoise", "--validation"];
+    args.extend(small);
+    let log = render_ok(&args, dir, &[]);
+    assert!(
+        log.contains("denoised: Intel Open Image Denoise 2.5.1, high quality, with the albedo and normal images"),
+        "{log}"
+    );
+    assert_eq!(entries(dir), ["d.exr", "d.png"]);
+    let exr = Exr::read(&dir.join("d.exr"));
+    for name in quadray::output::EXR_NOISY_CHANNELS.iter().chain(&quadray::output::EXR_DENOISE_CHANNELS) {
+        assert!(exr.names().iter().any(|n| n == name), "{name} missing from {:?}", exr.names());
+    }
+    let file = quadray::output::read_render_exr(&dir.join("d.exr")).unwrap();
+    let denoised = file.output.denoised.as_ref().expect("the denoised image");
+    assert_ne!(denoised, &file.output.radiance, "the denoised image is the raw one");
+    assert_eq!(file.output.radiance, exr.vec3(quadray::output::EXR_NOISY_CHANNELS), "the raw radiance is kept");
+    assert!(file.metadata.iter().any(|(k, v)| k == quadray::output::METADATA_DENOISED && v.contains("2.5.1")));
+    // The PNG shows the denoised image.
+    let png = image::open(dir.join("d.png")).unwrap().to_rgb8();
+    let i = 18 * 48 + 24;
+    for (k, v) in denoised[i].iter().enumerate() {
+        assert!(png.as_raw()[3 * i + k].abs_diff(srgb8(*v)) <= 1, "PNG pixel {i}");
+    }
+    // Denoised again from the file: the same image.
+    let again = dir.join("again.exr");
+    let log = render_ok(&["denoise", dir.join("d.exr").to_str().unwrap(), "-o", again.to_str().unwrap()], dir, &[]);
+    assert!(log.contains("denoised: Intel Open Image Denoise"), "{log}");
+    let twice = quadray::output::read_render_exr(&again).unwrap().output;
+    assert_eq!(twice.radiance, file.output.radiance);
+    let most = denoised.iter().flatten().zip(twice.denoised.as_ref().unwrap().iter().flatten());
+    for (a, b) in most {
+        assert!((a - b).abs() <= 1e-4 * a.abs().max(1e-3), "denoised {a} then {b}");
+    }
+
+    // Without the library.
+    let empty = tempfile::tempdir().unwrap();
+    let e = empty.path();
+    let missing = [("QUADRAY_OIDN_LIB", "/nonexistent/libOpenImageDenoise.so.2")];
+    let x = e.join("x");
+    for extra in [&["--denoise"][..], &["--preset", "preview"][..]] {
+        let mut args = vec!["render", "-o", x.to_str().unwrap()];
+        args.extend(small);
+        args.extend(extra);
+        let o = quadray(&args, e, &missing);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{stderr}");
+        assert!(
+            stderr.contains("Intel Open Image Denoise is not installed")
+                && stderr.contains("/nonexistent/libOpenImageDenoise.so.2")
+                && stderr.contains("make setup")
+                && stderr.contains("--no-denoise"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(entries(e).is_empty(), "wrote {:?}", entries(e));
+    }
+    let o = quadray(&["denoise", dir.join("d.exr").to_str().unwrap(), "-o", x.to_str().unwrap()], e, &missing);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("not installed"));
+    assert!(entries(e).is_empty(), "wrote {:?}", entries(e));
+    // The same preset renders without it when told not to denoise.
+    let mut args = vec!["render", "-o", x.to_str().unwrap(), "--preset", "preview", "--no-denoise"];
+    args.extend(small);
+    render_ok(&args, e, &missing);
 }

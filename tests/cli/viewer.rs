@@ -8,6 +8,9 @@
 //!   and a capture of the window as the X server holds it;
 //! - both match an offscreen `quadray render` of the same view (FLIP of the
 //!   tone-mapped images, and of the EXR radiance);
+//! - at `interactive` quality it shows the denoised image, and the denoise
+//!   key switches to the raw samples and back (each matches the offscreen
+//!   render with and without `--denoise`);
 //! - it is resized (the render follows the window: a screenshot at the new
 //!   size matches an offscreen render at that size), minimised and restored,
 //!   has its filtering mode, preset and passes switched and its camera
@@ -99,7 +102,10 @@ fn window_screenshots_match_the_offscreen_render_through_resize_and_close() {
     let path = |name: &str| d.join(name);
     let dir_arg = d.to_str().unwrap();
 
-    let script = "wait 4; screenshot first; frames 2; capture first-window; \
+    // `interactive` denoises: `key n` shows the raw samples, and again the
+    // denoised image.
+    let script = "wait 4; screenshot first; key n; frames 1; screenshot raw; key n; frames 2; \
+                  capture first-window; \
                   resize 112x80; wait 4; screenshot resized; frames 2; capture resized-window; \
                   minimize; frames 2; restore; frames 2; \
                   key f; key c; key v; orbit 30 10; key 1; wait 1; key 3; frames 1; screenshot last; close";
@@ -122,23 +128,44 @@ fn window_screenshots_match_the_offscreen_render_through_resize_and_close() {
     eprintln!("{log}");
     assert!(log.contains("viewer closed after"), "{log}");
 
-    for (name, (w, h), shot) in [("first", ("128", "96"), "first"), ("resized", ("112", "80"), "resized")] {
+    for (name, (w, h), denoise) in [
+        ("first", ("128", "96"), "--denoise"),
+        ("raw", ("128", "96"), "--no-denoise"),
+        ("resized", ("112", "80"), "--denoise"),
+    ] {
         let reference = path(&format!("{name}-offscreen"));
         quadray(
-            &["render", "--preset", "interactive", "--width", w, "--height", h, "-o", reference.to_str().unwrap()],
+            &[
+                "render",
+                "--preset",
+                "interactive",
+                denoise,
+                "--width",
+                w,
+                "--height",
+                h,
+                "-o",
+                reference.to_str().unwrap(),
+            ],
             None,
         );
         let offscreen_png = reference.with_extension("png");
         let offscreen_exr = reference.with_extension("exr");
-        let shown = png_flip(&offscreen_png, &path(&format!("{shot}.png")));
-        let window = png_flip(&offscreen_png, &path(&format!("{shot}-window.png")));
-        let radiance = exr_flip(&offscreen_exr, &path(&format!("{shot}.exr")));
+        let shown = png_flip(&offscreen_png, &path(&format!("{name}.png")));
+        let window = if name == "raw" { 0.0 } else { png_flip(&offscreen_png, &path(&format!("{name}-window.png"))) };
+        let radiance = exr_flip(&offscreen_exr, &path(&format!("{name}.exr")));
         eprintln!(
-            "{name} ({w}x{h}): FLIP against the offscreen render: presented frame {shown:.5}, window as the X \
-             server shows it {window:.5}, EXR radiance {radiance:.5} (bound {FLIP_BOUND})"
+            "{name} ({w}x{h}, {denoise}): FLIP against the offscreen render: presented frame {shown:.5}, window as \
+             the X server shows it {window:.5}, EXR radiance {radiance:.5} (bound {FLIP_BOUND})"
         );
         assert!(shown < FLIP_BOUND && window < FLIP_BOUND && radiance < FLIP_BOUND);
+        // The denoised screenshots keep the raw radiance beside the
+        // denoised; the raw one has only the raw.
+        let file = quadray::output::read_render_exr(&path(&format!("{name}.exr"))).unwrap();
+        assert_eq!(file.output.denoised.is_some(), denoise == "--denoise", "{name}.exr");
     }
+    // Denoised and raw differ (the key did something).
+    assert!(png_flip(&path("first.png"), &path("raw.png")) > 0.02);
     // The last screenshot: after the toggles, at the `final` preset's first frames.
     let last = image::open(path("last.png")).unwrap().to_rgb8();
     assert_eq!(last.dimensions(), (112, 80));

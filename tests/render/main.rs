@@ -9,6 +9,7 @@ mod common;
 mod backends;
 mod caustics;
 mod convergence;
+mod denoise;
 mod energy;
 mod filtering;
 mod furnace;

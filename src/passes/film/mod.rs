@@ -26,7 +26,12 @@ pub struct RenderOutput {
     pub frame_size: (u32, u32),
     /// Mean radiance per pixel (linear RGB).
     pub radiance: Vec<[f32; 3]>,
-    /// Depth, normal and albedo per pixel from the pixel-centre ray.
+    /// The radiance denoised (Intel Open Image Denoise, `crate::denoise`),
+    /// when the render was: the PNG and the EXR's RGB show it, and
+    /// `radiance` stays beside it as the EXR's `noisy.RGB`.
+    pub denoised: Option<Vec<[f32; 3]>>,
+    /// Depth, normal, albedo and object per pixel from the pixel-centre ray,
+    /// and the denoiser's albedo and normal averaged over the samples.
     pub aov: Vec<GpuAov>,
     /// Samples per pixel taken (every pixel has at least this many; an
     /// interrupted render's pixels in the tiles of its next sample that
@@ -58,6 +63,12 @@ pub struct RenderOutput {
 }
 
 impl RenderOutput {
+    /// The image to show: the denoised radiance when there is one, else
+    /// the radiance.
+    pub fn shown(&self) -> &[[f32; 3]] {
+        self.denoised.as_deref().unwrap_or(&self.radiance)
+    }
+
     /// An image without render data (AOVs, times): one read from a file.
     pub fn from_radiance(width: u32, height: u32, radiance: Vec<[f32; 3]>) -> Self {
         Self {
@@ -66,6 +77,7 @@ impl RenderOutput {
             bounds: PixelBounds::full(width, height),
             frame_size: (width, height),
             radiance,
+            denoised: None,
             aov: vec![],
             spp: 0,
             partial_tiles: 0,
@@ -99,7 +111,8 @@ pub struct Accumulation {
     pub sums: Vec<[f32; 4]>,
     /// Per pixel: the largest sample's luminance and index.
     pub max_sample: Vec<[f32; 2]>,
-    /// Per pixel: the AOVs of the pixel-centre ray.
+    /// Per pixel: the AOVs of the pixel-centre ray, and the denoiser's
+    /// features summed over the samples.
     pub aov: Vec<GpuAov>,
 }
 
@@ -116,6 +129,20 @@ impl Accumulation {
                 [s[0] / n, s[1] / n, s[2] / n]
             })
             .collect();
+        // The denoiser's features are sums over the samples on the GPU.
+        let aov = self
+            .aov
+            .iter()
+            .zip(counts)
+            .map(|(a, &c)| {
+                let n = c.max(1) as f32;
+                GpuAov {
+                    denoise_albedo: a.denoise_albedo.map(|v| v / n),
+                    denoise_normal: a.denoise_normal.map(|v| v / n),
+                    ..*a
+                }
+            })
+            .collect();
         let dropped_samples =
             self.sums.iter().zip(counts).map(|(s, &c)| (c as f64 - s[3] as f64).round().max(0.0) as u64).sum();
         RenderOutput {
@@ -124,7 +151,8 @@ impl Accumulation {
             bounds: self.bounds,
             frame_size: self.frame_size,
             radiance,
-            aov: self.aov,
+            denoised: None,
+            aov,
             spp: self.samples,
             partial_tiles: self.partial_tiles,
             seconds: self.render_seconds,

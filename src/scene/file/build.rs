@@ -9,8 +9,8 @@ use toml::Spanned;
 use crate::hash::hash_unit;
 
 use super::{
-    Camera, CameraKeyframe, CausticSettings, ConductorFresnel, FilterMode, ImageSettings, Light, Material,
-    MaterialKind, Preset, Quality, Scene, SceneObject, UvMapping, UvSettings, VolumeSettings,
+    Camera, CameraKeyframe, CausticSettings, ConductorFresnel, DenoiseQuality, FilterMode, ImageSettings, Light,
+    Material, MaterialKind, Preset, Quality, Scene, SceneObject, UvMapping, UvSettings, VolumeSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, GeometryError, Perturbation, Quadric};
 
@@ -28,6 +28,12 @@ pub(super) fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneErr
         Some(f) => f.get_ref().parse::<FilterMode>().map_err(|e| src.error(Some(f.span()), "image.filter", e))?,
         None => quality.filter,
     };
+    let denoise_quality = match image.and_then(|i| i.denoise_quality.as_ref()) {
+        Some(q) => {
+            q.get_ref().parse::<DenoiseQuality>().map_err(|e| src.error(Some(q.span()), "image.denoise_quality", e))?
+        }
+        None => DenoiseQuality::default(),
+    };
     let image = ImageSettings {
         width: image.and_then(|i| i.width).map_or(640, |v| v.get() as u32),
         height: image.and_then(|i| i.height).map_or(480, |v| v.get() as u32),
@@ -37,6 +43,8 @@ pub(super) fn build_scene(src: &Source, raw: RawScene) -> Result<Scene, SceneErr
         max_depth: image.and_then(|i| i.max_depth).map_or(quality.max_depth, |v| v.get() as u32),
         filter,
         preset,
+        denoise: image.and_then(|i| i.denoise).unwrap_or(quality.denoise),
+        denoise_quality,
     };
     let camera = build_camera(src, &raw.camera)?;
     if let (Some(background), Some(environment)) = (&raw.background, &raw.environment) {

@@ -31,9 +31,9 @@ mod values;
 use std::path::{Path, PathBuf};
 
 use super::{
-    Camera, CameraKeyframe, CausticSettings, ConductorFresnel, EnvironmentMapSettings, FilterMode, ImageSettings,
-    Light, Material, MaterialKind, MaterialMaps, Medium, Preset, Quality, Scene, SceneObject, TextureImage, UvMapping,
-    UvSettings, VolumeSettings,
+    Camera, CameraKeyframe, CausticSettings, ConductorFresnel, DenoiseQuality, EnvironmentMapSettings, FilterMode,
+    ImageSettings, Light, Material, MaterialKind, MaterialMaps, Medium, Preset, Quality, Scene, SceneObject,
+    TextureImage, UvMapping, UvSettings, VolumeSettings,
 };
 
 use build::*;

@@ -39,6 +39,8 @@ pub(super) struct RawImage {
     pub(super) max_depth: Option<Depth>,
     pub(super) preset: Option<Spanned<String>>,
     pub(super) filter: Option<Spanned<String>>,
+    pub(super) denoise: Option<bool>,
+    pub(super) denoise_quality: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]

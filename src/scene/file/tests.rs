@@ -4,8 +4,8 @@ use super::*;
 use glam::{DAffine3, DVec2, DVec3, Vec3};
 
 use super::super::{
-    Camera, ConductorFresnel, EnvironmentMapSettings, FilterMode, ImageSettings, Light, Material, MaterialKind,
-    MaterialMaps, Preset, Scene, UvMapping, UvSettings,
+    Camera, ConductorFresnel, DenoiseQuality, EnvironmentMapSettings, FilterMode, ImageSettings, Light, Material,
+    MaterialKind, MaterialMaps, Preset, Scene, UvMapping, UvSettings,
 };
 use crate::geometry::{Aabb, FunctionalObject, Quadric};
 use crate::texture;
@@ -39,7 +39,9 @@ fn defaults() {
             exposure: 0.0,
             max_depth: 6,
             filter: FilterMode::None,
-            preset: None
+            preset: None,
+            denoise: false,
+            denoise_quality: DenoiseQuality::High,
         }
     );
     assert_eq!(s.camera.up, DVec3::Y);
@@ -59,6 +61,13 @@ fn presets_set_the_quality_and_the_files_keys_override_them() {
     assert_eq!((s.image.max_depth, s.volume.samples), (10, 3));
     let s = parse_scene(&format!("[image]\nfilter = \"ray-cones\"\n{CAMERA}"), "t.toml").unwrap();
     assert_eq!((s.image.filter, s.image.preset, s.image.spp), (FilterMode::RayCones, None, 16));
+    // Denoising: the quick presets turn it on, the file's key overrides.
+    let s = parse_scene(&format!("[image]\npreset = \"preview\"\n{CAMERA}"), "t.toml").unwrap();
+    assert!(s.image.denoise);
+    let s = parse_scene(&format!("[image]\npreset = \"interactive\"\ndenoise = false\n{CAMERA}"), "t.toml").unwrap();
+    assert!(!s.image.denoise);
+    let s = parse_scene(&format!("[image]\ndenoise = true\ndenoise_quality = \"fast\"\n{CAMERA}"), "t.toml").unwrap();
+    assert_eq!((s.image.denoise, s.image.denoise_quality), (true, DenoiseQuality::Fast));
 }
 
 #[test]
@@ -67,6 +76,10 @@ fn unknown_presets_and_filters_are_errors_at_their_line() {
     assert!(e.starts_with("t.toml:2:10: image.preset: unknown preset `fast`"), "{e}");
     let e = parse_scene(&format!("[image]\nwidth = 8\nfilter = \"ewa\"\n{CAMERA}"), "t.toml").unwrap_err().to_string();
     assert!(e.starts_with("t.toml:3:10: image.filter: unknown filter `ewa`"), "{e}");
+    let e = parse_scene(&format!("[image]\ndenoise_quality = \"best\"\n{CAMERA}"), "t.toml").unwrap_err().to_string();
+    assert!(e.starts_with("t.toml:2:19: image.denoise_quality: unknown denoise quality `best`"), "{e}");
+    let e = parse_scene(&format!("[image]\ndenoise = \"yes\"\n{CAMERA}"), "t.toml").unwrap_err().to_string();
+    assert!(e.contains("image.denoise"), "{e}");
 }
 
 #[test]
@@ -83,7 +96,9 @@ fn image_and_background() {
             exposure: -1.5,
             max_depth: 12,
             filter: FilterMode::None,
-            preset: None
+            preset: None,
+            denoise: false,
+            denoise_quality: DenoiseQuality::High,
         }
     );
     assert_eq!(s.background, Vec3::new(0.1, 0.2, 0.3));
