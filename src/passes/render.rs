@@ -135,7 +135,9 @@ pub struct Renderer {
     max_sample: Image,
     readback: Buffer,
     path: Buffer,
+    /// The AOVs and feature sums (device memory), and their host copy.
     aov: Buffer,
+    aov_readback: Buffer,
     timer: GpuTimer,
     tiles: Vec<[u32; 4]>,
     // Tiles of sample `samples` already added (an interrupted sample).
@@ -250,8 +252,20 @@ impl Renderer {
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        let aov =
-            Buffer::storage(device, "aov", pixels * std::mem::size_of::<GpuAov>() as u64, MemoryLocation::GpuToCpu)?;
+        // The AOVs and the denoiser's feature sums: read and written by every
+        // sample, so in device memory; copied to `aov_readback` to be read.
+        let aov_bytes = pixels * std::mem::size_of::<GpuAov>() as u64;
+        let aov_usage = vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_SRC
+            | vk::BufferUsageFlags::TRANSFER_DST;
+        let aov = Buffer::new(device, "aov", aov_bytes, aov_usage, MemoryLocation::GpuOnly)?;
+        let aov_readback = Buffer::new(
+            device,
+            "aov readback",
+            aov_bytes,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
         // The recorded path (`GpuPathRecord`): a count, then the vertices.
         let path_bytes = std::mem::size_of::<GpuPathRecord>() as u64;
         let path = Buffer::storage(device, "recorded path", path_bytes, MemoryLocation::GpuToCpu)?;
@@ -300,6 +314,7 @@ impl Renderer {
             readback,
             path,
             aov,
+            aov_readback,
             timer: GpuTimer::new(device)?,
             tiles,
             tiles_done: 0,
@@ -466,7 +481,16 @@ impl Renderer {
         let pixels = (self.size.0 * self.size.1) as usize;
         let sums: Vec<[f32; 4]> = self.read_image(cmds, &self.accum)?;
         let max_sample: Vec<[f32; 2]> = self.read_image(cmds, &self.max_sample)?;
-        let aov: Vec<GpuAov> = self.aov.read();
+        let (aov_buffer, aov_readback) = (&self.aov, &self.aov_readback);
+        let samples = [Access::ShaderWrite(self.pipeline.stage())];
+        cmds.run(|rec| {
+            // The last read-back's copy wrote the host copy (its host read
+            // came after the fence); the samples wrote the AOVs.
+            rec.barrier(&[Access::TransferWrite, samples[0]], &[Access::TransferRead, Access::TransferWrite]);
+            aov_buffer.copy_to(rec, aov_readback);
+            rec.barrier(&[Access::TransferRead], &samples);
+        })?;
+        let aov: Vec<GpuAov> = self.aov_readback.read();
         Ok(Accumulation {
             frame_size: self.size,
             bounds: self.bounds,
@@ -509,9 +533,10 @@ impl Renderer {
         self.bounds.insert(&acc.sums, &mut sums, width);
         let mut largest = vec![[0f32; 2]; pixels];
         self.bounds.insert(&acc.max_sample, &mut largest, width);
-        let mut aov: Vec<GpuAov> = self.aov.read();
+        // Pixels outside the bounds are never rendered: zero.
+        let mut aov = vec![GpuAov::default(); self.aov.size as usize / std::mem::size_of::<GpuAov>()];
         self.bounds.insert(&acc.aov, &mut aov[..pixels], width);
-        self.aov.write(0, bytemuck::cast_slice(&aov));
+        let aov_upload = Buffer::with_data(&self.device, "aov upload", &aov, vk::BufferUsageFlags::TRANSFER_SRC)?;
         let mut staging = Buffer::new(
             &self.device,
             "accumulation upload",
@@ -521,10 +546,13 @@ impl Renderer {
         )?;
         staging.write(0, bytemuck::cast_slice(&sums));
         staging.write(pixels * 16, bytemuck::cast_slice(&largest));
-        let (accum, max_sample) = (&self.accum, &self.max_sample);
+        let (accum, max_sample, aov_buffer) = (&self.accum, &self.max_sample, &self.aov);
         let samples = [Access::ShaderWrite(self.pipeline.stage())];
         let upload = [Access::TransferWrite];
         cmds.run(|rec| {
+            rec.barrier(&samples, &upload);
+            aov_upload.copy_to(rec, aov_buffer);
+            rec.barrier(&upload, &samples);
             for (image, offset) in [(accum, 0), (max_sample, pixels as u64 * 16)] {
                 image.transition(
                     rec,

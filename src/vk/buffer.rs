@@ -113,6 +113,18 @@ impl Buffer {
         unsafe { rec.device.cmd_fill_buffer(rec.cmd, self.raw, 0, vk::WHOLE_SIZE, word) };
     }
 
+    /// Records copying the whole buffer into `dst` (at least as large): a
+    /// transfer read of this buffer and a transfer write of `dst`. This
+    /// buffer needs `TRANSFER_SRC` usage and `dst` `TRANSFER_DST`.
+    pub fn copy_to(&self, rec: Recording<'_>, dst: &Buffer) {
+        assert!(dst.size >= self.size, "copy of {} bytes into a buffer of {}", self.size, dst.size);
+        let region = [vk::BufferCopy::default().size(self.size)];
+        // SAFETY: both buffers are alive while the submission runs (the
+        // caller holds them across `Commands::run`, which waits), `dst` holds
+        // the region, and the caller's barriers order the copy.
+        unsafe { rec.device.cmd_copy_buffer(rec.cmd, self.raw, dst.raw, &region) };
+    }
+
     /// Copies `bytes` into the (host-visible) buffer at `offset`.
     pub fn write(&mut self, offset: usize, bytes: &[u8]) {
         self.bytes_mut()[offset..offset + bytes.len()].copy_from_slice(bytes);
