@@ -47,6 +47,9 @@ void renderPixel(uvec2 local) {
         aov.denoiseNormal[k] += f.normal[k];
     }
     aovs[idx] = aov;
+    // No NaN or Inf ever leaves the renderer: such a sample counts as black,
+    // and the accumulation's fourth channel counts only the finite samples,
+    // so that the host can report how many were dropped.
     bool finite = !any(isnan(radiance)) && !any(isinf(radiance));
     ivec2 at = ivec2(pix);
     imageStore(accum, at, imageLoad(accum, at) + (finite ? vec4(radiance, 1.0) : vec4(0.0)));

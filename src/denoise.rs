@@ -294,6 +294,13 @@ impl Drop for Denoiser {
     }
 }
 
+/// True when `out` has the denoiser's features: every render has them, an
+/// EXR read from a file where it has the AOV channels (with zero features
+/// where it lacks theirs).
+pub fn has_features(out: &crate::passes::RenderOutput) -> bool {
+    out.aov.len() == out.radiance.len()
+}
+
 /// [`Denoiser::denoise`] of a render: its radiance with the denoiser's
 /// features from its AOVs (colour only when it has none, e.g. an EXR
 /// without them).
@@ -302,7 +309,7 @@ pub fn denoise_output(
     out: &crate::passes::RenderOutput,
     quality: DenoiseQuality,
 ) -> Result<Vec<[f32; 3]>, DenoiseError> {
-    let has_features = out.aov.len() == out.radiance.len();
+    let has_features = has_features(out);
     let albedo: Vec<[f32; 3]> = if has_features { out.aov.iter().map(|a| a.denoise_albedo).collect() } else { vec![] };
     let normal: Vec<[f32; 3]> = if has_features { out.aov.iter().map(|a| a.denoise_normal).collect() } else { vec![] };
     let input = DenoiseInput {

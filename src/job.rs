@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 
 use crate::passes::checkpoint::{render_key, Checkpoint, CheckpointError};
 use crate::passes::{GpuScene, PixelBounds, RenderOutput, RenderVariant, Renderer};
-use crate::scene::{ImageSettings, Scene};
+use crate::scene::{DenoiseQuality, Scene};
 use crate::{vk, RenderError};
 
 /// How a job renders and when it stops.
@@ -95,12 +95,12 @@ pub fn image_key(scene: &Scene, variant: RenderVariant) -> u64 {
 /// `scene` with the settings that do not change the render (denoising,
 /// applied to the finished image) at their defaults, for the keys.
 fn keyed(scene: &Scene) -> std::borrow::Cow<'_, Scene> {
-    let plain = ImageSettings::minimal(0, 0);
-    if (scene.image.denoise, scene.image.denoise_quality) == (plain.denoise, plain.denoise_quality) {
+    let plain = (false, DenoiseQuality::default());
+    if (scene.image.denoise, scene.image.denoise_quality) == plain {
         return std::borrow::Cow::Borrowed(scene);
     }
     let mut s = scene.clone();
-    (s.image.denoise, s.image.denoise_quality) = (plain.denoise, plain.denoise_quality);
+    (s.image.denoise, s.image.denoise_quality) = plain;
     std::borrow::Cow::Owned(s)
 }
 

@@ -141,8 +141,8 @@ pub(crate) struct QualityArgs {
     #[arg(long, overrides_with = "denoise")]
     pub(crate) no_denoise: bool,
     /// The denoiser's quality (overrides `image.denoise_quality`): `fast`,
-    /// `balanced` or `high` (the default: the albedo and normal images are
-    /// denoised first, OIDN's advice for features that carry noise).
+    /// `balanced` or `high` (the default: the best network, 2-6x the time
+    /// of `fast`).
     #[arg(long)]
     pub(crate) denoise_quality: Option<quadray::denoise::DenoiseQuality>,
 }

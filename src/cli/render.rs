@@ -348,7 +348,7 @@ pub(crate) fn denoise_into(
     quality: quadray::denoise::DenoiseQuality,
 ) -> Result<String> {
     let start = std::time::Instant::now();
-    let features = out.aov.len() == out.radiance.len();
+    let features = quadray::denoise::has_features(out);
     out.denoised = Some(quadray::denoise::denoise_output(denoiser, out, quality)?);
     let v = denoiser.version;
     Ok(format!(

@@ -152,8 +152,6 @@ struct App {
     /// The denoiser, loaded when the view first needs it; the reason it
     /// could not be, after which the view shows raw samples.
     denoiser: Option<Result<Denoiser, String>>,
-    /// Samples of the denoised frame on screen (0: none of this view).
-    denoised_spp: u32,
     /// Show the current samples again (denoising was switched).
     refresh: bool,
     error: Option<ViewerError>,
@@ -181,7 +179,6 @@ impl App {
             cursor: (0.0, 0.0),
             resize_pending: false,
             denoiser: None,
-            denoised_spp: 0,
             refresh: false,
             error: None,
             config,
@@ -392,22 +389,18 @@ impl App {
             None
         };
         self.refresh = false;
-        if self.shown.is_none() {
-            self.denoised_spp = 0;
-        }
         if let Some(mut out) = fresh {
-            let showing_denoised = self.shown.as_ref().is_some_and(|(o, _)| o.denoised.is_some());
+            // The samples of the denoised frame on screen, if one is.
+            let denoised_spp = self.shown.as_ref().filter(|(o, _)| o.denoised.is_some()).map(|(o, _)| o.spp);
+            let showing_denoised = denoised_spp.is_some();
             // Denoised once the view rests (two samples, or all it will
             // get), then again each time its samples double.
-            let due = !showing_denoised || out.spp >= target || out.spp >= 2 * self.denoised_spp.max(1);
+            let due = denoised_spp.is_none_or(|n| out.spp >= target || out.spp >= 2 * n);
             let denoise = self.scene.image.denoise && (out.spp >= 2 || out.spp >= target);
             if denoise && due {
                 if let Some(d) = Self::denoiser(&mut self.denoiser) {
                     match crate::denoise::denoise_output(d, &out, self.scene.image.denoise_quality) {
-                        Ok(image) => {
-                            out.denoised = Some(image);
-                            self.denoised_spp = out.spp;
-                        }
+                        Ok(image) => out.denoised = Some(image),
                         Err(e) => {
                             log::warn!("{e}; showing the samples without denoising");
                             self.denoiser = Some(Err(e.to_string()));

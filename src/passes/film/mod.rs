@@ -116,31 +116,27 @@ pub struct Accumulation {
     pub aov: Vec<GpuAov>,
 }
 
+/// A sum over `count` samples divided by their count (a pixel without
+/// samples keeps its sum, zero).
+fn mean_of(sum: [f32; 3], count: u32) -> [f32; 3] {
+    let n = count.max(1) as f32;
+    sum.map(|v| v / n)
+}
+
 impl Accumulation {
     /// The image of the work so far, `counts[i]` samples in pixel i (dropped
     /// samples black); times and pass reports are left empty.
     pub fn into_output(self, counts: &[u32]) -> RenderOutput {
-        let radiance = self
-            .sums
-            .iter()
-            .zip(counts)
-            .map(|(s, &c)| {
-                let n = c.max(1) as f32;
-                [s[0] / n, s[1] / n, s[2] / n]
-            })
-            .collect();
+        let radiance = self.sums.iter().zip(counts).map(|(s, &c)| mean_of([s[0], s[1], s[2]], c)).collect();
         // The denoiser's features are sums over the samples on the GPU.
         let aov = self
             .aov
             .iter()
             .zip(counts)
-            .map(|(a, &c)| {
-                let n = c.max(1) as f32;
-                GpuAov {
-                    denoise_albedo: a.denoise_albedo.map(|v| v / n),
-                    denoise_normal: a.denoise_normal.map(|v| v / n),
-                    ..*a
-                }
+            .map(|(a, &c)| GpuAov {
+                denoise_albedo: mean_of(a.denoise_albedo, c),
+                denoise_normal: mean_of(a.denoise_normal, c),
+                ..*a
             })
             .collect();
         let dropped_samples =
