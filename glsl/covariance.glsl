@@ -18,21 +18,38 @@
 #define COVARIANCE_GLSL
 
 struct PathCovariance {
-    mat4 p;    // primal covariance of (x, y, θ, φ); columns, GLSL convention
+    // The primal covariance of (x, y, θ, φ) in 2 x 2 blocks (every operator
+    // below is block-structured, so the 4 x 4 products are never formed):
+    // P = [xx xa; xaᵀ aa], xa the covariance of the spatial offsets (rows)
+    // with the angular ones (columns); GLSL's column-major mat2 throughout.
+    mat2 xx;
+    mat2 xa;
+    mat2 aa;
     vec3 e1;   // frame across the ray
     vec3 e2;
 };
 
+// The kinds of turn of bounceTurns.
+const uint TURN_REFLECT = 0u;
+const uint TURN_DIFFUSE = 1u;
+const uint TURN_REFRACT = 2u;
+
 // Largest variance kept (keeps the matrix finite; about a 1e6 std).
 const float COV_MAX = 1e12;
 
-mat4 covClamp(mat4 m) {
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
+mat2 covClamp2(mat2 m) {
+    for (int c = 0; c < 2; ++c)
+        for (int r = 0; r < 2; ++r) {
             float v = m[c][r];
             m[c][r] = (isnan(v) || isinf(v)) ? 0.0 : clamp(v, -COV_MAX, COV_MAX);
         }
     return m;
+}
+
+void covClamp(inout PathCovariance c) {
+    c.xx = covClamp2(c.xx);
+    c.xa = covClamp2(c.xa);
+    c.aa = covClamp2(c.aa);
 }
 
 // At the camera: the footprint's share of the pixel filter, a Gaussian of
@@ -43,28 +60,29 @@ PathCovariance covCamera(vec3 d, vec3 up, float sigma) {
     c.e1 = normalize(cross(d, up));
     c.e2 = cross(c.e1, d);
     float v = sigma * sigma;
-    c.p = mat4(0.0);
-    c.p[2][2] = v;
-    c.p[3][3] = v;
+    c.xx = mat2(0.0);
+    c.xa = mat2(0.0);
+    c.aa = mat2(v);
     return c;
 }
 
 // Free travel over distance t: x += t θ, y += t φ.
 void covTravel(inout PathCovariance c, float t) {
-    mat4 a = mat4(1.0);
-    a[2][0] = t;  // column θ, row x
-    a[3][1] = t;
-    c.p = covClamp(a * c.p * transpose(a));
+    c.xx += t * (c.xa + transpose(c.xa)) + (t * t) * c.aa;
+    c.xa += t * c.aa;
+    covClamp(c);
 }
 
 // Re-expresses the spatial and angular offsets in a new frame (e1n, e2n)
 // across the same ray.
 void covRotate(inout PathCovariance c, vec3 e1n, vec3 e2n) {
     mat2 m = mat2(dot(c.e1, e1n), dot(c.e1, e2n), dot(c.e2, e1n), dot(c.e2, e2n));
-    mat4 a = mat4(0.0);
-    a[0][0] = m[0][0]; a[0][1] = m[0][1]; a[1][0] = m[1][0]; a[1][1] = m[1][1];
-    a[2][2] = m[0][0]; a[2][3] = m[0][1]; a[3][2] = m[1][0]; a[3][3] = m[1][1];
-    c.p = covClamp(a * c.p * transpose(a));
+    mat2 mt = transpose(m);
+    // The same rotation of the spatial and the angular offsets.
+    c.xx = m * c.xx * mt;
+    c.xa = m * c.xa * mt;
+    c.aa = m * c.aa * mt;
+    covClamp(c);
     c.e1 = e1n;
     c.e2 = e2n;
 }
@@ -89,43 +107,100 @@ mat2 covOnSurface(inout PathCovariance c, vec3 d, vec3 n, vec3 t1, vec3 t2, out 
     e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, d));
     covRotate(c, e1n, t2);
     inv = 1.0 / max(abs(dot(d, n)), MIN_FOOTPRINT_COS);
-    return mat2(c.p[0][0] * inv * inv, c.p[0][1] * inv, c.p[1][0] * inv, c.p[1][1]);
+    return mat2(c.xx[0][0] * inv * inv, c.xx[0][1] * inv, c.xx[1][0] * inv, c.xx[1][1]);
+}
+
+// The frame across an outgoing ray wi chosen as in covOnSurface: e1 from
+// t1, e2 across wi and e1 on t2's side (orthonormal also where wi leaves
+// the plane of incidence, as a glossy sample does).
+void outgoingFrame(vec3 t1, vec3 t2, vec3 wi, out vec3 e1n, out vec3 e2n) {
+    e1n = t1 - wi * dot(wi, t1);
+    float el = length(e1n);
+    e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, wi));
+    e2n = cross(wi, e1n);
+    if (dot(e2n, t2) < 0.0) e2n = -e2n;
 }
 
 // Leaves the surface along wi. With the frames chosen as in covOnSurface
 // (e1 from t1, e2 from t2, on both sides) a flat mirror is the identity (the
 // unfolded path); the spatial offsets are the surface offsets seen across
-// the outgoing ray; a refraction scales the angles by (η cos θi / cos θt, η)
-// (first order).
-//
-// Curvature (Belcour et al. 2013, sec. 4, "curvature", here in primal form):
-// at surface offset u = (x / |cos θ|, y) the normal facing the incoming ray
-// tilts by S u (S: shape operator of that normal in (t1, t2)), which turns
-// the outgoing direction by g ⊙ (S u). The gains g, from differentiating the
-// reflection and refraction laws (in the plane of incidence, then across it):
-// mirror reflection (2, 2 cos θi); refraction (η cos θi / cos θt − 1,
-// η cos θi − cos θt); a diffuse lobe turns with the normal (1, 1). The
-// operator is the shear θ' = s ⊙ θ + g ⊙ (S u). The lobe itself is sampled
-// (the path's direction wi), so its bandwidth is not added here.
-void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, vec2 angleScale, mat2 shape, vec2 gain) {
-    vec3 e1n = t1 - wi * dot(wi, t1);
-    float el = length(e1n);
-    e1n = el > 1e-6 ? e1n / el : normalize(cross(t2, wi));
-    vec3 e2n = t2 - wi * dot(wi, t2);
-    float e2l = length(e2n);
-    e2n = e2l > 1e-6 ? e2n / e2l : normalize(cross(wi, e1n));
+// the outgoing ray. The outgoing angles: θ' = A θ + T (S u), with the
+// columns of A and T given as world vectors (bounceJacobian) and taken
+// across wi here:
+// - A: how the outgoing direction turns per unit turn of the incoming one
+//   along the incoming frame's e1, e2 (`ang1`, `ang2`);
+// - curvature (Belcour et al. 2013, sec. 4, "curvature", here in primal
+//   form): at surface offset u = (x / |cos θ|, y) the normal facing the
+//   incoming ray tilts by S u (S: shape operator of that normal in
+//   (t1, t2)), which turns the outgoing direction by T (S u): `turn1`,
+//   `turn2` per unit tilt along t1 and t2.
+// The lobe itself is sampled (the path's direction wi), so its bandwidth is
+// not added here.
+void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, mat2 shape, vec3 turn1, vec3 turn2,
+               vec3 ang1, vec3 ang2) {
+    vec3 e1n, e2n;
+    outgoingFrame(t1, t2, wi, e1n, e2n);
     // Incoming (x, y) -> surface (x / |cos θ|, y) -> outgoing across wi.
     mat2 toSurface = mat2(inv, 0.0, 0.0, 1.0);
     mat2 m = mat2(dot(t1, e1n), dot(t1, e2n), dot(t2, e1n), dot(t2, e2n)) * toSurface;
-    mat2 shear = mat2(gain.x, 0.0, 0.0, gain.y) * shape * toSurface;
-    mat4 a = mat4(0.0);
-    a[0][0] = m[0][0]; a[0][1] = m[0][1]; a[1][0] = m[1][0]; a[1][1] = m[1][1];
-    a[0][2] = shear[0][0]; a[0][3] = shear[0][1]; a[1][2] = shear[1][0]; a[1][3] = shear[1][1];
-    a[2][2] = angleScale.x;
-    a[3][3] = angleScale.y;
-    c.p = covClamp(a * c.p * transpose(a));
+    mat2 turn = mat2(dot(turn1, e1n), dot(turn1, e2n), dot(turn2, e1n), dot(turn2, e2n));
+    mat2 shear = turn * shape * toSurface;
+    mat2 dg = mat2(dot(ang1, e1n), dot(ang1, e2n), dot(ang2, e1n), dot(ang2, e2n));
+    // The operator [m 0; shear A] in blocks: x' = m x, θ' = shear x + A θ.
+    mat2 dgT = transpose(dg);
+    mat2 xxS = c.xx * transpose(shear);
+    mat2 xaD = c.xa * dgT;
+    mat2 sx = shear * xaD;
+    mat2 aa = shear * xxS + sx + transpose(sx) + dg * c.aa * dgT;
+    c.xa = m * (xxS + xaD);
+    c.xx = m * c.xx * transpose(m);
+    c.aa = aa;
+    covClamp(c);
     c.e1 = e1n;
     c.e2 = e2n;
+}
+
+// How a sampled direction `next` changes around the path (covBounce's A
+// and T), for "the same lobe sample" on the rays around it: the sample is
+// fixed in the surface's frame, which turns with the normal (a tilt of the
+// facing normal nf along t is the rotation ω = nf × t).
+// - A reflection keeps its microfacet normal m = (next − d) / |next − d|:
+//   next = d − 2 (d·m) m. A turn of d moves next by its mirror image about
+//   m (ang); a tilt turns m by ω × m and next by −2 ((d·δm) m + (d·m) δm)
+//   (turn). About m = nf this is the identity for A and gains of 2 in the
+//   plane of incidence and 2 cos θ across it.
+// - A diffuse sample turns with the frame (ω × next); A is the identity, as
+//   for a mirror (the incoming spread carried on).
+// - Refraction: first order in the plane of incidence, then across it
+//   (Belcour et al. 2013, appendix): angles scale by `scale`
+//   (η cos θi / cos θt, η) and a tilt turns next by `gain`
+//   (η cos θi / cos θt − 1, η cos θi − cos θt), along e1n, e2n.
+// e1, e2: the incoming frame (covOnSurface's).
+void bounceJacobian(vec3 d, vec3 e1, vec3 e2, vec3 nf, vec3 next, vec3 t1, vec3 t2, uint lobe, vec2 scale,
+                    vec2 gain, out vec3 turn1, out vec3 turn2, out vec3 ang1, out vec3 ang2) {
+    vec3 e1n, e2n;
+    outgoingFrame(t1, t2, next, e1n, e2n);
+    if (lobe == TURN_REFRACT) {
+        turn1 = gain.x * e1n;
+        turn2 = gain.y * e2n;
+        ang1 = scale.x * e1n;
+        ang2 = scale.y * e2n;
+    } else if (lobe == TURN_DIFFUSE) {
+        turn1 = t1 * dot(nf, next) - nf * dot(t1, next);
+        turn2 = t2 * dot(nf, next) - nf * dot(t2, next);
+        ang1 = e1n;
+        ang2 = e2n;
+    } else {
+        vec3 h = next - d;
+        float hl = length(h);
+        vec3 m = hl > 1e-6 ? h / hl : nf;
+        vec3 dm1 = t1 * dot(nf, m) - nf * dot(t1, m);
+        vec3 dm2 = t2 * dot(nf, m) - nf * dot(t2, m);
+        turn1 = -2.0 * (dot(d, dm1) * m + dot(d, m) * dm1);
+        turn2 = -2.0 * (dot(d, dm2) * m + dot(d, m) * dm2);
+        ang1 = e1 - 2.0 * dot(e1, m) * m;
+        ang2 = e2 - 2.0 * dot(e2, m) * m;
+    }
 }
 
 // A scattering event in a medium, into direction wi: the bundle's spatial

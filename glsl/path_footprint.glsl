@@ -28,7 +28,15 @@ struct HitFootprint {
     vec3 t1, t2;
     float covInv;  // covOnSurface's inverse cosine, for covBounce
     float width;   // the ray cone's width σ at the hit
+    // The lookups' random choices (texfilter.glsl, Footprint.xi): a seed for
+    // their numbers, or none (stochastic false: deterministic lookups).
+    uint seed;
+    bool stochastic;
 };
+
+// The numbers of the next lookup's random choices (texfilter.glsl,
+// Footprint.xi), or -1: the deterministic lookup.
+vec2 nextLookupXi(inout HitFootprint hf) { return hf.stochastic ? rand2(hf.seed) : vec2(-1.0); }
 
 // A ray cone's footprint on the surface, in the basis (t1, t2): σ across the
 // ray, σ / |cos θ| along t1 (stretch bounded: MIN_FOOTPRINT_COS).
@@ -44,6 +52,8 @@ HitFootprint coneHitFootprint(vec3 d, vec3 n, float sigma) {
     f.footprint = coneFootprint(d, n, sigma);
     f.covInv = 1.0;
     f.width = sigma;
+    f.seed = 0u;
+    f.stochastic = false;
     return f;
 }
 
@@ -74,6 +84,8 @@ HitFootprint footprintAtHit(inout PathFootprint f, vec3 d, vec3 n, float t) {
     hf.width = f.coneWidth + f.coneSpread * t;
     footprintBasis(d, n, hf.t1, hf.t2);
     hf.covInv = 1.0;
+    hf.seed = 0u;
+    hf.stochastic = false;
     if (FILTER_MODE == FILTER_COVARIANCE) {
         covTravel(f.cov, t);
         hf.footprint = covOnSurface(f.cov, d, n, hf.t1, hf.t2, hf.covInv);
@@ -86,7 +98,8 @@ HitFootprint footprintAtHit(inout PathFootprint f, vec3 d, vec3 n, float t) {
 // The outgoing footprint after a BSDF sample at hit h: the normal facing
 // the incoming ray d tilts by S u at surface offset u (S: its shape
 // operator, exact from the Hessian of F'), which turns the outgoing
-// direction `next` by the gains g ⊙ (S u) (covariance.glsl, covBounce);
+// direction `next` (covariance.glsl, bounceJacobian and covBounce; ray cones:
+// by the gains g ⊙ (S u) of a mirror or a refraction);
 // refraction also scales the angles. wo and wi are the local directions of
 // the sample (z along the shading normal), ior the material's relative index.
 void footprintBounce(inout PathFootprint f, HitFootprint hf, SceneHit h, vec3 d, vec3 next, vec3 wo, vec3 wi,
@@ -102,9 +115,14 @@ void footprintBounce(inout PathFootprint f, HitFootprint hf, SceneHit h, vec3 d,
     } else if (kind == MATERIAL_DIFFUSE) {
         gain = vec2(1.0);
     }
-    mat2 shape = shapeOperator(h, hf.t1, hf.t2) * (dot(d, h.normal) < 0.0 ? 1.0 : -1.0);
+    float facing = dot(d, h.normal) < 0.0 ? 1.0 : -1.0;
+    mat2 shape = shapeOperator(h, hf.t1, hf.t2) * facing;
     if (FILTER_MODE == FILTER_COVARIANCE) {
-        covBounce(f.cov, hf.covInv, hf.t1, hf.t2, next, scale, shape, gain);
+        uint turnKind = transmitted ? TURN_REFRACT : (kind == MATERIAL_DIFFUSE ? TURN_DIFFUSE : TURN_REFLECT);
+        vec3 turn1, turn2, ang1, ang2;
+        bounceJacobian(d, f.cov.e1, f.cov.e2, h.normal * facing, next, hf.t1, hf.t2, turnKind, scale, gain, turn1,
+                       turn2, ang1, ang2);
+        covBounce(f.cov, hf.covInv, hf.t1, hf.t2, next, shape, turn1, turn2, ang1, ang2);
     } else {
         // Ray cones: the curvature term of Akenine-Möller et al. 2021 (the
         // cone's edge rays turn by the gain times the mean curvature times

@@ -13,9 +13,15 @@ layout(constant_id = SPEC_RECORD_PATH) const uint RECORD_PATH = 0u;
 
 layout(set = 0, binding = BINDING_RENDER_PATH, scalar) buffer PathRecordBuffer { PathRecord path; };
 
+// The footprint that the next record() stores (a surface event's, set by
+// surfaceVertex; PathVertex.footprint), cleared by it.
+vec3 recordFootprint = vec3(0.0);
+
 void record(uint event, uint object, uint material, uint lobe, float t, float cosO, float cosI, float pdf, vec3 position,
             vec3 weight, vec3 throughput, vec3 radiance) {
     if (RECORD_PATH == 0u) return;
+    vec3 footprint = recordFootprint;
+    recordFootprint = vec3(0.0);
     // `count` counts every event; the last slot is kept for EVENT_END, so
     // that a path longer than the record still shows how it ended (the host
     // reports the events left out).
@@ -28,7 +34,7 @@ void record(uint event, uint object, uint material, uint lobe, float t, float co
     }
     path.vertices[i] = PathVertex(event, object, material, lobe, t, cosO, cosI, pdf, float[3](position.x, position.y,
         position.z), float[3](weight.x, weight.y, weight.z), float[3](throughput.x, throughput.y, throughput.z),
-        float[3](radiance.x, radiance.y, radiance.z));
+        float[3](radiance.x, radiance.y, radiance.z), float[3](footprint.x, footprint.y, footprint.z));
 }
 
 #endif

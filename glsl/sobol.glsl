@@ -82,6 +82,15 @@ PathSampler pathSampler(uvec2 pixel, uint sampleIndex, uint seed) {
 
 vec2 sample2(inout PathSampler s) { return SAMPLER == SAMPLER_SOBOL ? sobolSample2(s.sobol) : rand2(s.rng); }
 
+// A seed for random numbers outside the sampler's sequence (its decisions
+// stay as they are), for choices that need no stratification (the mip
+// level of a texture lookup): a hash of the pixel's sample, how far along
+// its sequence it is, and `key`.
+uint sideSeed(PathSampler s, uint key) {
+    uint state = SAMPLER == SAMPLER_SOBOL ? pcgHash(s.sobol.seed ^ pcgHash(s.sobol.index ^ pcgHash(s.sobol.dimension))) : s.rng;
+    return pcgHash(state ^ pcgHash(key + 0x68e31da4u));
+}
+
 // A 1D decision: the first coordinate of a Sobol pair, or one random number.
 float sample1(inout PathSampler s) { return SAMPLER == SAMPLER_SOBOL ? sobolSample2(s.sobol).x : rand(s.rng); }
 

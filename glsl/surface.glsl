@@ -52,9 +52,11 @@ Material surfaceAt(SceneHit h, vec3 d, HitFootprint hf, out vec3 shadingNormal) 
     fp.axis1 = vec2(dot(gu, w1), dot(gv, w1));
     fp.axis2 = vec2(dot(gu, w2), dot(gv, w2));
     if (mat.albedoMap != NO_TEXTURE) {
+        fp.xi = nextLookupXi(hf);
         vec3 a = v3(mat.albedo) * lookup(mat.albedoMap, fp).rgb;
         mat.albedo = float[3](a.x, a.y, a.z);
     }
+    fp.xi = nextLookupXi(hf);
     if (mat.roughnessMap != NO_TEXTURE) mat.roughness = clamp(lookup(mat.roughnessMap, fp).r, 0.0, 1.0);
     if (mat.normalMap == NO_TEXTURE && mat.displacementMap == NO_TEXTURE) return mat;
     vec3 dpdu, dpdv;
@@ -71,6 +73,7 @@ Material surfaceAt(SceneHit h, vec3 d, HitFootprint hf, out vec3 shadingNormal) 
         // Bump mapping: the normal of p + scale · height(u, v) · n.
         vec2 slopes;
         if (lean) {
+            fp.xi = nextLookupXi(hf);
             vec4 m = lookup(mat.displacementMoments, fp);
             slopes = m.xy * mat.displacementScale;
             // World slopes are uv slopes over |∂p/∂u|, |∂p/∂v|.
@@ -88,6 +91,7 @@ Material surfaceAt(SceneHit h, vec3 d, HitFootprint hf, out vec3 shadingNormal) 
     if (mat.normalMap != NO_TEXTURE) {
         vec3 c;
         if (lean) {
+            fp.xi = nextLookupXi(hf);
             vec4 m = lookup(mat.normalMoments, fp);
             c = normalize(vec3(-m.x, -m.y, 1.0));
             slopeVar += slopeVariance(m);

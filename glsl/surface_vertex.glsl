@@ -66,6 +66,10 @@ void surfaceVertex(inout PathState s, SceneHit h, Medium med, uint pixel, inout 
     // The footprint at this hit, built once: the texture lookups and the
     // bounce below share it.
     HitFootprint hitFoot = footprintAtHit(s.foot, s.d, h.normal, h.t);
+    // The lookups choose their mip levels and probe positions at random
+    // (texfilter.glsl), from numbers outside the sampler's sequence.
+    hitFoot.seed = sideSeed(rng, s.bounce);
+    hitFoot.stochastic = true;
     Material mat = surfaceAt(h, s.d, hitFoot, ns);
     if (SHADING_MODE != SHADING_FULL && albedoModeEnds(s, mat)) return;
     uint matIndex = objects[h.object].material;
@@ -118,11 +122,13 @@ void surfaceVertex(inout PathState s, SceneHit h, Medium med, uint pixel, inout 
     // leave glass it never entered with an η² gain. The path ends there.
     bool transmits = bs.wi.z * wo.z < 0.0;
     if (!bs.valid || (dot(next, h.normal) * dot(s.d, h.normal) > 0.0) != transmits) {
+        recordFootprint = vec3(hitFoot.footprint[0][0], hitFoot.footprint[0][1], hitFoot.footprint[1][1]);
         record(EVENT_SURFACE, h.object, matIndex, LOBE_INVALID, h.t, wo.z, bs.wi.z, bs.pdf, p, bs.weight, s.throughput,
                s.radiance);
         s.alive = false;
         return;
     }
+    recordFootprint = vec3(hitFoot.footprint[0][0], hitFoot.footprint[0][1], hitFoot.footprint[1][1]);
     record(EVENT_SURFACE, h.object, matIndex, transmits ? LOBE_TRANSMIT : LOBE_REFLECT, h.t, wo.z, bs.wi.z, bs.pdf, p,
            bs.weight, s.throughput * bs.weight, s.radiance);
     if (CAUSTICS_ENABLED != 0u) followCausticPath(s, mat, receiver, wo, bs.wi);

@@ -1,6 +1,7 @@
 // Filtered texture lookups over a footprint: an elliptical Gaussian in
-// (u, v), given by its two semi-axes (1σ). Two lookups: trilinear probes
-// along the major axis (probeLookup, the default) and elliptical weighted
+// (u, v), given by its two semi-axes (1σ). Two lookups: probes along the
+// major axis (probeLookup, the default: Feline's fixed probes, or one at a
+// random place for a short footprint in a render) and elliptical weighted
 // averaging (ewaLookup, the reference), both with a bounded anisotropy. The
 // including shader declares `sampler2D textures[]` first.
 #ifndef TEXFILTER_GLSL
@@ -10,6 +11,10 @@ struct Footprint {
     vec2 uv;
     vec2 axis1;   // semi-axes (1σ) of the Gaussian footprint in (u, v)
     vec2 axis2;
+    // Random numbers in [0, 1) of the stochastic lookup: x chooses the mip
+    // level (levelChoice; x < 0: the trilinear blend), y places a short
+    // footprint's probe along its major axis (randomProbe; y < 0: fixed probes).
+    vec2 xi;
 };
 
 // A footprint meeting a surface at grazing incidence stretches along it by
@@ -74,6 +79,20 @@ float trilinearLevel(float v) {
     return l + clamp((x / exp2(2.0 * l) - 1.0) / 3.0, 0.0, 1.0);
 }
 
+// Stochastic texture filtering (M. Pharr, B. Wronski, M. Salvi, M. Fajardo,
+// "Filtering After Shading With Stochastic Texture Filtering", I3D 2024):
+// a trilinear lookup at λ = L + w blends levels L and L + 1 with weights
+// 1 - w and w; reading level L + 1 with probability w and L otherwise (xi
+// uniform in [0, 1)) has the same expectation with one level's fetches.
+// Every sample of a pixel draws its own xi, so the choice averages out with
+// the rest of the path's noise. xi < 0 keeps the deterministic blend (the
+// pixel-centre AOVs, some lookup tests).
+float levelChoice(float lod, float xi) {
+    if (xi < 0.0) return lod;
+    float l = floor(lod);
+    return xi < lod - l ? l + 1.0 : l;
+}
+
 // Most trilinear probes along the major axis of one lookup.
 const int MAX_PROBES = 8;
 
@@ -86,15 +105,9 @@ const int MAX_PROBES = 8;
 // stays near 1 %), up to MAX_PROBES; beyond that the minor axis widens (the
 // probes' level rises) until MAX_PROBES cover the major axis. The probes
 // match the Gaussian's mean and covariance, not its shape.
-vec4 probeLookup(uint index, Footprint fp) {
-    vec2 s0 = vec2(textureSize(textures[nonuniformEXT(index)], 0));
-    float last = float(textureQueryLevels(textures[nonuniformEXT(index)]) - 1);
-    TexelEllipse el = texelEllipse(fp, s0);
+vec4 felineProbes(uint index, Footprint fp, TexelEllipse el, vec2 s0, float last) {
     float minor = el.l2;
     float rest = el.l1 - minor;
-    if (rest <= 0.05 * (minor + 1.0 / 6.0)) {
-        return textureLod(textures[nonuniformEXT(index)], fp.uv, min(trilinearLevel(el.l1), last));
-    }
     // Probe σ (with the reconstruction's own) against the rest's σ: probes
     // spaced at most 2 probe σ apart over ±2 σ of the rest.
     float probeSigma = sqrt(minor + 1.0 / 6.0);
@@ -106,7 +119,7 @@ vec4 probeLookup(uint index, Footprint fp) {
         rest = el.l1 - minor;
         n = MAX_PROBES;
     }
-    float lod = min(trilinearLevel(minor), last);
+    float lod = levelChoice(min(trilinearLevel(minor), last), fp.xi.x);
     float sigmaRest = sqrt(rest);
     float spacing = 4.0 * sigmaRest / float(n - 1);
     // Gaussian weights on the offsets, then the offsets scaled so that the
@@ -126,6 +139,47 @@ vec4 probeLookup(uint index, Footprint fp) {
         sum += weights[k] * textureLod(textures[nonuniformEXT(index)], fp.uv + (float(k) - 0.5 * float(n - 1)) * step, lod);
     }
     return sum / sw;
+}
+
+
+// Φ⁻¹(p), the standard normal quantile (M. Abramowitz, I. Stegun, Handbook
+// of Mathematical Functions, 26.2.23: |error| < 4.5e-4), p clamped to
+// [1e-6, 1 - 1e-6] (±4.75).
+float normalQuantile(float p) {
+    p = clamp(p, 1e-6, 1.0 - 1e-6);
+    float q = min(p, 1.0 - p);
+    float t = sqrt(-2.0 * log(q));
+    float x = t - (2.515517 + t * (0.802853 + t * 0.010328)) / (1.0 + t * (1.432788 + t * (0.189269 + t * 0.001308)));
+    return p < 0.5 ? -x : x;
+}
+
+// One probe at a random place (stochastic texture filtering, Pharr et al.
+// 2024, above) for a footprint at most about twice as long as wide (the
+// rest's σ at most the probe's): the probe's isotropic kernel has the minor
+// variance l2 and its offset along the major axis is drawn from the rest's
+// Gaussian, Φ⁻¹(xi.y) σ_rest, so that its mean over xi is the footprint's
+// exact convolution with one probe where the fixed probes take two or three.
+vec4 randomProbe(uint index, Footprint fp, TexelEllipse el, vec2 s0, float last) {
+    float lod = levelChoice(min(trilinearLevel(el.l2), last), fp.xi.x);
+    vec2 offset = el.e1 / s0 * (sqrt(el.l1 - el.l2) * normalQuantile(fp.xi.y));
+    return textureLod(textures[nonuniformEXT(index)], fp.uv + offset, lod);
+}
+
+// The renderer's lookup: one probe at the centre for a near-isotropic
+// footprint (the major axis less than 5 % longer in variance), one probe at
+// a random place along the major axis for one up to about twice as long as
+// wide when random numbers are given (xi.y >= 0), else Feline's fixed
+// probes.
+vec4 probeLookup(uint index, Footprint fp) {
+    vec2 s0 = vec2(textureSize(textures[nonuniformEXT(index)], 0));
+    float last = float(textureQueryLevels(textures[nonuniformEXT(index)]) - 1);
+    TexelEllipse el = texelEllipse(fp, s0);
+    float rest = el.l1 - el.l2;
+    if (rest <= 0.05 * (el.l2 + 1.0 / 6.0)) {
+        return textureLod(textures[nonuniformEXT(index)], fp.uv, levelChoice(min(trilinearLevel(el.l1), last), fp.xi.x));
+    }
+    if (fp.xi.y >= 0.0 && rest <= el.l2 + 1.0 / 6.0) return randomProbe(index, fp, el, s0, last);
+    return felineProbes(index, fp, el, s0, last);
 }
 
 // The reference lookup (`--lookup ewa`): elliptical weighted averaging

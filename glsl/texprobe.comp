@@ -32,6 +32,7 @@ void main() {
     fp.uv = q.uv;
     fp.axis1 = q.axis1;
     fp.axis2 = q.axis2;
+    fp.xi = q.xi;
     TexResult r;
     r.value = LOOKUP_MODE == LOOKUP_EWA ? ewaLookup(q.texture, fp) : probeLookup(q.texture, fp);
     r.alpha = leanAlpha(q.alpha, r.value);

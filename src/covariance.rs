@@ -289,18 +289,38 @@ impl Covariance4 {
     /// Entries of `K` are clamped to `±MAX_CURVATURE`.
     /// First order, exact at normal incidence; at oblique incidence the
     /// turn out of the plane of incidence is really `2 cos θ` times the tilt,
-    /// which this operator (like the paper's) ignores.
+    /// which this operator (like the paper's) ignores
+    /// ([`Self::reflection_curvature`] does not).
     pub fn curvature_tensor(&self, k: DMat2) -> Self {
-        let k = DMat2::from_cols_array(&k.to_cols_array().map(|v| v.clamp(-MAX_CURVATURE, MAX_CURVATURE)));
+        self.angular_shear(k * 2.0)
+    }
+
+    /// [`Self::curvature_tensor`] with the exact first-order turn of a
+    /// mirror reflection at incidence angle θ (`cos_theta`, clamped as in
+    /// the projections): the reflected direction turns by twice the tilt of
+    /// the normal in the plane of incidence (`x`) and by `2 cos θ` times it
+    /// across (`y`), so `θ' = θ − G K u` with `G = diag(2, 2 cos θ)`. The
+    /// twin of the GPU's mirror bounce (glsl/covariance.glsl, bounceJacobian);
+    /// equal to [`Self::curvature_tensor`] at normal incidence.
+    pub fn reflection_curvature(&self, k: DMat2, cos_theta: f64) -> Self {
+        let g = DMat2::from_diagonal(DVec2::new(2.0, 2.0 * clamp_cos(cos_theta)));
+        self.angular_shear(g * k)
+    }
+
+    /// The primal angular shear `θ' = θ − M u` (M: 2 x 2, entries clamped to
+    /// `±2 MAX_CURVATURE`); in the spectrum `Σ' = C Σ Cᵀ`, `C = [[I, Mᵀ], [0, I]]`.
+    fn angular_shear(&self, m: DMat2) -> Self {
+        let bound = 2.0 * MAX_CURVATURE;
+        let m = DMat2::from_cols_array(&m.to_cols_array().map(|v| v.clamp(-bound, bound)));
         let shear = |f: f64| {
             rows([
                 [1.0, 0.0, 0.0, 0.0],
                 [0.0, 1.0, 0.0, 0.0],
-                [f * k.x_axis.x, f * k.y_axis.x, 1.0, 0.0],
-                [f * k.x_axis.y, f * k.y_axis.y, 0.0, 1.0],
+                [f * m.x_axis.x, f * m.y_axis.x, 1.0, 0.0],
+                [f * m.x_axis.y, f * m.y_axis.y, 0.0, 1.0],
             ])
         };
-        self.apply(shear(-2.0), shear(2.0))
+        self.apply(shear(-1.0), shear(1.0))
     }
 
     /// Reflection symmetry (Belcour 2013, sec. 4). With the outgoing frame

@@ -86,12 +86,13 @@ pub(crate) struct BenchArgs {
 
 #[derive(Parser, Debug)]
 pub(crate) struct FilterBenchArgs {
-    /// Scene files (default: the three texture-dominated scenes and the two
+    /// Scene files (default: the four texture-dominated scenes and the two
     /// figure-1 scenes, lighting-dominated controls).
     #[arg(default_values = [
         "scenes/glints.toml",
         "scenes/glossy_window.toml",
         "scenes/anisotropic.toml",
+        "scenes/curved_mirrors.toml",
         "scenes/figure1_left.toml",
         "scenes/figure1_right.toml",
     ])]

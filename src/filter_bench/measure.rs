@@ -265,16 +265,23 @@ pub(super) fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result
             config.targets, config.max_spp
         )));
     }
-    // Every mode's accumulations, by mode then spp.
-    let mut accumulations: Vec<(String, u32, Accumulation)> = Vec::new();
+    // Every mode's accumulations, by mode then spp. The modes take turns
+    // render by render (after every mode's warm-up), so that a drift of the
+    // machine's speed over the run falls on all of them alike and their cost
+    // per sample compares like with like.
     for (name, filter) in MODES {
         eprintln!("{stem}: {name}: warming up");
         bench.warm_up(filter)?;
-        for (k, &spp) in ladder.iter().enumerate() {
-            let mut acc = Accumulation::new(pixels);
-            for s in 0..config.seeds {
-                // A different seed per render: independent noise.
-                let out = bench.render(filter, spp, seed.wrapping_add(1 + k as u32 * 1009 + s * 7919), 0.0)?;
+    }
+    let mut grid: Vec<Vec<Accumulation>> =
+        MODES.iter().map(|_| ladder.iter().map(|_| Accumulation::new(pixels)).collect()).collect();
+    for (k, &spp) in ladder.iter().enumerate() {
+        for s in 0..config.seeds {
+            // A different seed per render: independent noise (the same seeds for every mode).
+            let render_seed = seed.wrapping_add(1 + k as u32 * 1009 + s * 7919);
+            for (m, (name, filter)) in MODES.iter().enumerate() {
+                let out = bench.render(*filter, spp, render_seed, 0.0)?;
+                let acc = &mut grid[m][k];
                 acc.flip += flip_mean(&reference.image, &out, exposure)?;
                 acc.add(&out);
                 if s == 0 && (k == 0 || spp == config.max_spp) {
@@ -282,7 +289,10 @@ pub(super) fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result
                     write_png(&out, exposure, &png).map_err(io_error(&png))?;
                 }
             }
-            let st = reference.stats(&acc, &all);
+        }
+        for (m, (name, _)) in MODES.iter().enumerate() {
+            let acc = &grid[m][k];
+            let st = reference.stats(acc, &all);
             eprintln!(
                 "{stem}: {name:>10} {spp:>5} spp {:>8.3} s  rel MSE {:.5} (bias² {:.5}, variance {:.5})  FLIP {:.4}",
                 acc.seconds / f64::from(acc.count),
@@ -291,9 +301,13 @@ pub(super) fn bench_scene(ctx: &Context, config: &Config, path: &Path) -> Result
                 st.variance,
                 acc.flip / f64::from(acc.count)
             );
-            accumulations.push((name.to_string(), spp, acc));
         }
     }
+    let accumulations: Vec<(String, u32, Accumulation)> = MODES
+        .iter()
+        .zip(grid)
+        .flat_map(|((name, _), accs)| ladder.iter().zip(accs).map(move |(&spp, acc)| (name.to_string(), spp, acc)))
+        .collect();
 
     // The maps' share of none's error, and the texture mask, at each target.
     let textured = bench.replace_scene(with_mean_maps(&bench.scene))?;

@@ -11,7 +11,8 @@
 //! 2. each mode (`none`, `ray-cones`, `covariance`) at 1, 2, 4, … samples per
 //!    pixel, `seeds` independent renders per point, after an untimed warm-up
 //!    (lavapipe compiles a shader variant at its first dispatch), timed on
-//!    the GPU. The error is the relative MSE of the linear radiance against
+//!    the GPU; the modes take turns render by render, so that the machine's
+//!    drift falls on all alike. The error is the relative MSE of the linear radiance against
 //!    the reference (its noise subtracted), split into variance (across the
 //!    seeds) and bias² (the rest); FLIP is the secondary figure;
 //! 3. the texture share at each target spp: 1 − (the error of `none` with

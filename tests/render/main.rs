@@ -12,6 +12,7 @@ mod convergence;
 mod denoise;
 mod energy;
 mod filtering;
+mod footprint;
 mod furnace;
 mod lights;
 mod loop_budget;
