@@ -29,7 +29,7 @@ struct PathCovariance {
     vec3 e2;
 };
 
-// The kinds of turn of bounceTurns.
+// The kinds of bounce of bounceJacobian.
 const uint TURN_REFLECT = 0u;
 const uint TURN_DIFFUSE = 1u;
 const uint TURN_REFRACT = 2u;
@@ -124,28 +124,22 @@ void outgoingFrame(vec3 t1, vec3 t2, vec3 wi, out vec3 e1n, out vec3 e2n) {
 // Leaves the surface along wi. With the frames chosen as in covOnSurface
 // (e1 from t1, e2 from t2, on both sides) a flat mirror is the identity (the
 // unfolded path); the spatial offsets are the surface offsets seen across
-// the outgoing ray. The outgoing angles: θ' = A θ + T (S u), with the
-// columns of A and T given as world vectors (bounceJacobian) and taken
-// across wi here:
+// the outgoing ray (e1n, e2n: outgoingFrame's). The outgoing angles:
+// θ' = A θ + T (S u) (A and T from bounceJacobian, in that frame):
 // - A: how the outgoing direction turns per unit turn of the incoming one
-//   along the incoming frame's e1, e2 (`ang1`, `ang2`);
+//   along the incoming frame's e1, e2;
 // - curvature (Belcour et al. 2013, sec. 4, "curvature", here in primal
 //   form): at surface offset u = (x / |cos θ|, y) the normal facing the
 //   incoming ray tilts by S u (S: shape operator of that normal in
-//   (t1, t2)), which turns the outgoing direction by T (S u): `turn1`,
-//   `turn2` per unit tilt along t1 and t2.
-// The lobe itself is sampled (the path's direction wi), so its bandwidth is
+//   (t1, t2)), which turns the outgoing direction by T (S u).
+// The lobe itself is sampled (the path's direction), so its bandwidth is
 // not added here.
-void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, mat2 shape, vec3 turn1, vec3 turn2,
-               vec3 ang1, vec3 ang2) {
-    vec3 e1n, e2n;
-    outgoingFrame(t1, t2, wi, e1n, e2n);
+void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 e1n, vec3 e2n, mat2 shape, mat2 turn,
+               mat2 dg) {
     // Incoming (x, y) -> surface (x / |cos θ|, y) -> outgoing across wi.
     mat2 toSurface = mat2(inv, 0.0, 0.0, 1.0);
     mat2 m = mat2(dot(t1, e1n), dot(t1, e2n), dot(t2, e1n), dot(t2, e2n)) * toSurface;
-    mat2 turn = mat2(dot(turn1, e1n), dot(turn1, e2n), dot(turn2, e1n), dot(turn2, e2n));
     mat2 shear = turn * shape * toSurface;
-    mat2 dg = mat2(dot(ang1, e1n), dot(ang1, e2n), dot(ang2, e1n), dot(ang2, e2n));
     // The operator [m 0; shear A] in blocks: x' = m x, θ' = shear x + A θ.
     mat2 dgT = transpose(dg);
     mat2 xxS = c.xx * transpose(shear);
@@ -175,21 +169,19 @@ void covBounce(inout PathCovariance c, float inv, vec3 t1, vec3 t2, vec3 wi, mat
 //   (Belcour et al. 2013, appendix): angles scale by `scale`
 //   (η cos θi / cos θt, η) and a tilt turns next by `gain`
 //   (η cos θi / cos θt − 1, η cos θi − cos θt), along e1n, e2n.
-// e1, e2: the incoming frame (covOnSurface's).
-void bounceJacobian(vec3 d, vec3 e1, vec3 e2, vec3 nf, vec3 next, vec3 t1, vec3 t2, uint lobe, vec2 scale,
-                    vec2 gain, out vec3 turn1, out vec3 turn2, out vec3 ang1, out vec3 ang2) {
-    vec3 e1n, e2n;
-    outgoingFrame(t1, t2, next, e1n, e2n);
+// e1, e2: the incoming frame (covOnSurface's); e1n, e2n: the outgoing one
+// (outgoingFrame's), in which A (`ang`) and T (`turn`) are returned.
+void bounceJacobian(vec3 d, vec3 e1, vec3 e2, vec3 nf, vec3 next, vec3 t1, vec3 t2, vec3 e1n, vec3 e2n, uint lobe,
+                    vec2 scale, vec2 gain, out mat2 turn, out mat2 ang) {
     if (lobe == TURN_REFRACT) {
-        turn1 = gain.x * e1n;
-        turn2 = gain.y * e2n;
-        ang1 = scale.x * e1n;
-        ang2 = scale.y * e2n;
-    } else if (lobe == TURN_DIFFUSE) {
+        turn = mat2(gain.x, 0.0, 0.0, gain.y);
+        ang = mat2(scale.x, 0.0, 0.0, scale.y);
+        return;
+    }
+    vec3 turn1, turn2, ang1 = e1n, ang2 = e2n;
+    if (lobe == TURN_DIFFUSE) {
         turn1 = t1 * dot(nf, next) - nf * dot(t1, next);
         turn2 = t2 * dot(nf, next) - nf * dot(t2, next);
-        ang1 = e1n;
-        ang2 = e2n;
     } else {
         vec3 h = next - d;
         float hl = length(h);
@@ -201,6 +193,9 @@ void bounceJacobian(vec3 d, vec3 e1, vec3 e2, vec3 nf, vec3 next, vec3 t1, vec3 
         ang1 = e1 - 2.0 * dot(e1, m) * m;
         ang2 = e2 - 2.0 * dot(e2, m) * m;
     }
+    // The world vectors (columns) taken across the outgoing ray.
+    turn = mat2(dot(turn1, e1n), dot(turn1, e2n), dot(turn2, e1n), dot(turn2, e2n));
+    ang = mat2(dot(ang1, e1n), dot(ang1, e2n), dot(ang2, e1n), dot(ang2, e2n));
 }
 
 // A scattering event in a medium, into direction wi: the bundle's spatial

@@ -119,10 +119,12 @@ void footprintBounce(inout PathFootprint f, HitFootprint hf, SceneHit h, vec3 d,
     mat2 shape = shapeOperator(h, hf.t1, hf.t2) * facing;
     if (FILTER_MODE == FILTER_COVARIANCE) {
         uint turnKind = transmitted ? TURN_REFRACT : (kind == MATERIAL_DIFFUSE ? TURN_DIFFUSE : TURN_REFLECT);
-        vec3 turn1, turn2, ang1, ang2;
-        bounceJacobian(d, f.cov.e1, f.cov.e2, h.normal * facing, next, hf.t1, hf.t2, turnKind, scale, gain, turn1,
-                       turn2, ang1, ang2);
-        covBounce(f.cov, hf.covInv, hf.t1, hf.t2, next, shape, turn1, turn2, ang1, ang2);
+        vec3 e1n, e2n;
+        outgoingFrame(hf.t1, hf.t2, next, e1n, e2n);
+        mat2 turn, ang;
+        bounceJacobian(d, f.cov.e1, f.cov.e2, h.normal * facing, next, hf.t1, hf.t2, e1n, e2n, turnKind, scale, gain,
+                       turn, ang);
+        covBounce(f.cov, hf.covInv, hf.t1, hf.t2, e1n, e2n, shape, turn, ang);
     } else {
         // Ray cones: the curvature term of Akenine-Möller et al. 2021 (the
         // cone's edge rays turn by the gain times the mean curvature times

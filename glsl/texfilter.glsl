@@ -141,7 +141,6 @@ vec4 felineProbes(uint index, Footprint fp, TexelEllipse el, vec2 s0, float last
     return sum / sw;
 }
 
-
 // Φ⁻¹(p), the standard normal quantile (M. Abramowitz, I. Stegun, Handbook
 // of Mathematical Functions, 26.2.23: |error| < 4.5e-4), p clamped to
 // [1e-6, 1 - 1e-6] (±4.75).
