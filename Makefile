@@ -25,6 +25,7 @@ all: test
 setup:
 	@bash scripts/setup-debian.sh
 	@bash scripts/setup-oidn.sh
+	@bash scripts/setup-vulkan-runtime.sh
 	@$(CARGO) fmt --version >/dev/null 2>&1 || rustup component add rustfmt
 	@$(CARGO) clippy --version >/dev/null 2>&1 || rustup component add clippy
 

@@ -13,7 +13,7 @@
 // (Emitter.reflectFirst) reflect instead at their first vertex (weight F),
 // which must be glass. Media along the way attenuate it by their
 // transmittance. The render pass leaves out exactly these paths from its own
-// estimate (see render.comp, "caustic paths"), so nothing is counted twice.
+// estimate (see render.glsl, "caustic paths"), so nothing is counted twice.
 #include "intersect.glsl"
 #include "bsdf.glsl"
 #include "frame.glsl"

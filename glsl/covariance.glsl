@@ -53,7 +53,7 @@ void covClamp(inout PathCovariance c) {
 }
 
 // At the camera: the footprint's share of the pixel filter, a Gaussian of
-// angular standard deviation `sigma` (render.comp, footprintSigma), no
+// angular standard deviation `sigma` (camera.glsl, footprintSigma), no
 // spatial extent (a pinhole).
 PathCovariance covCamera(vec3 d, vec3 up, float sigma) {
     PathCovariance c;

@@ -15,7 +15,7 @@ vec3 cameraRay(vec2 pixel) {
     return normalize(frame.forward + ndc.x * frame.right + ndc.y * frame.up);
 }
 
-// The pixel filter (render.comp, cameraJitter): a point u of the unit
+// The pixel filter (camera.glsl, cameraJitter): a point u of the unit
 // square taken by the Box-Muller transform to an offset (pixels) from the
 // pixel's centre with a Gaussian of standard deviation `sigma`.
 vec2 gaussianPixelOffset(vec2 u, float sigma) {

@@ -8,7 +8,7 @@
 // Ray cones: Akenine-Möller et al., "Improved Shader and Texture Level of
 // Detail Using Ray Cones", JCGT 2021, kept as a Gaussian: σ of the width
 // at the ray's origin and of the spread angle, starting from the footprint's
-// share of the pixel filter (render.comp, footprintSigma). Curved surfaces turn the
+// share of the pixel filter (camera.glsl, footprintSigma). Curved surfaces turn the
 // spread by their exact mean curvature. A rough or diffuse lobe does not
 // widen it: the lobe is sampled, and counting its bandwidth in the
 // footprint as well would filter twice.

@@ -65,7 +65,7 @@ layout(push_constant, scalar) uniform PushBlock { RenderPush pc; };
 layout(set = 0, binding = BINDING_RENDER_MAX_SAMPLE, rg32f) uniform image2D maxSample;
 
 #include "path_record.glsl"
-// Specialisation constant: SHADING_FULL, SHADING_NONE (the first hit's
+// Specialisation constant: SHADING_FULL, SHADING_ALBEDO (the first hit's
 // albedo: no light sampling, no bounces; benchmark breakdowns) or
 // SHADING_MIRRORED_ALBEDO (the albedo seen through perfect mirrors; tests).
 layout(constant_id = SPEC_SHADING_MODE) const uint SHADING_MODE = SHADING_FULL;

@@ -5,14 +5,14 @@
 #define SURFACE_VERTEX_GLSL
 
 // The test and benchmark shading modes (SPEC_SHADING_MODE), which end a
-// path at a surface with an albedo instead of shading it: SHADING_NONE at
+// path at a surface with an albedo instead of shading it: SHADING_ALBEDO at
 // the first hit, SHADING_MIRRORED_ALBEDO at the first surface that is not a
 // perfect mirror, SHADING_GLOSSY_ALBEDO at the first diffuse one. True when
 // the path ends here (its result in s.radiance).
 bool albedoModeEnds(inout PathState s, Material mat) {
-    bool ends = SHADING_MODE == SHADING_NONE || (SHADING_MODE == SHADING_MIRRORED_ALBEDO && mat.kind != MATERIAL_MIRROR)
+    bool ends = SHADING_MODE == SHADING_ALBEDO || (SHADING_MODE == SHADING_MIRRORED_ALBEDO && mat.kind != MATERIAL_MIRROR)
         || (SHADING_MODE == SHADING_GLOSSY_ALBEDO && mat.kind == MATERIAL_DIFFUSE);
-    if (ends) s.radiance = SHADING_MODE == SHADING_NONE ? v3(mat.albedo) : s.throughput * v3(mat.albedo);
+    if (ends) s.radiance = SHADING_MODE == SHADING_ALBEDO ? v3(mat.albedo) : s.throughput * v3(mat.albedo);
     if (ends) s.alive = false;
     return ends;
 }

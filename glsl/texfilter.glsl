@@ -42,7 +42,7 @@ vec4 texelWrapped(uint index, ivec2 t, int level, ivec2 size) {
 // (variance 4^L / 6) where level 0's is a tent of one (1/6). A lookup
 // therefore asks each level for the footprint's covariance *less* the blur
 // that the level itself adds, so that jitter ⊛ footprint stays the pixel
-// filter (render.comp, cameraJitter).
+// filter (camera.glsl, cameraJitter).
 
 // The footprint's covariance in level-0 texels: eigenvalues l1 >= l2
 // (variances along e1 and e2 = perp(e1)), the anisotropy bounded by

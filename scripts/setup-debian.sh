@@ -7,6 +7,8 @@
 #   - Debian's shaderc / glslang / SPIRV-Tools libraries, linked statically
 #     (see .cargo/config.toml) so that shaderc is not compiled from source,
 #   - a C/C++ toolchain for linking (gcc, g++, libc6-dev) and make,
+#   - curl, with which scripts/setup-vulkan-runtime.sh fetches the pinned
+#     Mesa 26.2 runtime from Debian unstable,
 #   - python3 with pip and unzip, which scripts/setup-oidn.sh uses to fetch
 #     Intel Open Image Denoise (the denoiser) from its pinned PyPI wheel,
 #   - Xvfb and the X11 client libraries winit loads at run time, for the
@@ -25,7 +27,7 @@ SUDO=""
 if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
 
 need_pkgs=(libvulkan1 vulkan-validationlayers libshaderc-dev glslang-dev spirv-tools
-           pkg-config gcc g++ libc6-dev make ca-certificates mesa-vulkan-drivers
+           pkg-config gcc g++ libc6-dev make ca-certificates curl mesa-vulkan-drivers
            python3 python3-pip unzip
            xvfb libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
 

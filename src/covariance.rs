@@ -1,5 +1,6 @@
 //! Covariance tracing of the local light field around a ray, used to
-//! prefilter textures along light paths (`../shared/seed/NOTES.md`, section 2).
+//! prefilter textures along light paths (the paper's section 2; Durand et al.
+//! 2005, Belcour et al. 2013).
 //!
 //! References (the operators below are re-derived here from the first-order
 //! ray model; no code was copied):

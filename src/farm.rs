@@ -419,6 +419,9 @@ impl Farm {
     /// An `sbatch` command with the options of every submission.
     fn sbatch(&self) -> Command {
         let mut cmd = Command::new("sbatch");
+        // The tasks start from the user's Vulkan environment (Slurm passes
+        // the submitter's on).
+        crate::vk::runtime::restore_env(&mut cmd);
         cmd.arg("--parsable")
             .arg(format!("--job-name=quadray-{}", self.manifest.name))
             .arg(format!("--cpus-per-task={}", self.manifest.cpus_per_task))

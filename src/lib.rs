@@ -1,5 +1,6 @@
 //! quadray: a Vulkan path tracer for functionally defined objects
-//! (perturbed quadrics), after Vyatkin & Dolgovesov 2022 (`../shared/seed/`).
+//! (perturbed quadrics), after Vyatkin & Dolgovesov, "Smoothing of
+//! functionally defined objects in scenes with global illumination" (2022).
 //!
 //! - [`geometry`]: the surfaces in f64 on the CPU (bounds, cells, the
 //!   reference intersection).

@@ -2,8 +2,6 @@
 
 mod cli;
 
-use std::path::PathBuf;
-
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
@@ -17,12 +15,26 @@ use cli::view::*;
 
 /// A Vulkan path tracer for functionally defined objects (perturbed quadrics).
 ///
-/// With no subcommand, renders the built-in default scene to render.png and render.exr.
+/// `quadray render` with no scene renders the built-in default scene to
+/// render.png and render.exr (denoised; the raw radiance kept in the EXR).
 #[derive(Parser, Debug)]
-#[command(version, about)]
+#[command(
+    version,
+    about,
+    after_help = "Start with:\n  quadray render                          the built-in default scene: render.png, render.exr\n  \
+                  quadray render scenes/spheres.toml -o spheres\n  quadray view scenes/default.toml        a window (headless: xvfb-run -a quadray view ...)\n  \
+                  quadray devices                         which Vulkan driver and device render\n\n\
+                  Scene files: scenes/README.md; the rest: README.md and docs/."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Use the system's Vulkan driver instead of the Vulkan runtime `make
+    /// setup` fetched (a current Mesa lavapipe, docs/vulkan-runtime.md).
+    /// QUADRAY_SYSTEM_VULKAN=1 does the same; QUADRAY_VULKAN_RUNTIME=DIR
+    /// names another runtime.
+    #[arg(long, global = true, env = "QUADRAY_SYSTEM_VULKAN", value_parser = clap::builder::BoolishValueParser::new())]
+    system_vulkan: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -36,7 +48,7 @@ enum Command {
     FilterBench(FilterBenchArgs),
     /// Open a window that renders a scene progressively, with an orbit and
     /// fly camera and keys for the filtering mode, preset, caustics, volume
-    /// and screenshots (README.md, "The viewer").
+    /// and screenshots (docs/viewer.md).
     #[cfg(feature = "viewer")]
     View(ViewArgs),
     /// Measure the quality presets' speed/accuracy trade: each scene rendered
@@ -62,8 +74,7 @@ enum Command {
     /// radiance kept as `noisy.RGB`). Needs the library (`make setup`).
     Denoise(DenoiseArgs),
     /// Render on a Slurm cluster: a job array of one task per tile and frame
-    /// (each idempotent and resumable), then a merge job (README.md, "Long
-    /// renders and farms").
+    /// (each idempotent and resumable), then a merge job (docs/farms.md).
     #[command(subcommand)]
     Farm(FarmCommand),
     /// List the Vulkan devices: driver, version, the ray-tracing extensions
@@ -98,16 +109,54 @@ fn default_lavapipe_threads() -> bool {
     true
 }
 
-fn main() -> Result<()> {
+/// Prints an error as `Error: ...` with its causes. A backtrace only where
+/// the error is internal (a Vulkan call that failed, a host/shader interface
+/// mismatch: a bug to report) and `RUST_BACKTRACE` asks for one; a mistake
+/// in the input or the setup gets its message alone.
+fn report(e: &anyhow::Error) {
+    eprintln!("Error: {e}");
+    let causes: Vec<String> = e.chain().skip(1).map(|c| c.to_string()).collect();
+    if !causes.is_empty() {
+        eprintln!("\nCaused by:");
+        for c in &causes {
+            eprintln!("    {c}");
+        }
+    }
+    use quadray::vk::VkError;
+    let internal =
+        e.chain().any(|c| matches!(c.downcast_ref::<VkError>(), Some(VkError::Vk(_) | VkError::Interface(_))));
+    if internal {
+        if e.backtrace().status() == std::backtrace::BacktraceStatus::Captured {
+            eprintln!("\nStack backtrace:\n{}", e.backtrace());
+        } else {
+            eprintln!("\n(an internal error: please report it with the scene; RUST_BACKTRACE=1 shows where it arose)");
+        }
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            report(&e);
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<()> {
     // A closed pipe on stdout (`quadray compare a.exr b.exr | head -1`) ends
     // the process quietly, as it does other command-line tools, instead of
     // a panic in println!.
     // SAFETY: called first, before any thread exists; SIG_DFL is a valid
     // disposition for SIGPIPE.
     unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
+    let cli = Cli::parse();
+    // Before any thread and any Vulkan call: may restart the process through
+    // the fetched Vulkan runtime's loader.
+    quadray::vk::runtime::enter(cli.system_vulkan)?;
     let set_threads = default_lavapipe_threads();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
     match cli.command {
         Some(Command::Render(args)) => render(args),
         Some(Command::FilterBench(args)) => filter_bench(args),
@@ -121,6 +170,11 @@ fn main() -> Result<()> {
         Some(Command::Denoise(args)) => denoise(args),
         Some(Command::Farm(cmd)) => farm(cmd),
         Some(Command::Devices(args)) => devices(args),
-        None => render(RenderArgs { output: PathBuf::from("render"), ..Default::default() }),
+        None => {
+            // Bare `quadray`: the usage, as pbrt and Mitsuba print theirs.
+            use clap::CommandFactory;
+            Cli::command().print_help()?;
+            Ok(())
+        }
     }
 }

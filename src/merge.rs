@@ -69,6 +69,12 @@ pub enum MergeError {
     },
 }
 
+/// Metadata that may differ between tiles (a farm's nodes may have other
+/// devices and drivers; each tile is denoised alone, and dropped); the
+/// device and driver are kept in the merged frame where all agree.
+const PER_TILE: [&str; 3] =
+    [crate::output::METADATA_DEVICE, crate::output::METADATA_DRIVER, crate::output::METADATA_DENOISED];
+
 fn value<'a>(metadata: &'a [(String, String)], name: &str) -> Option<&'a str> {
     metadata.iter().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
 }
@@ -93,7 +99,7 @@ pub fn merge(tiles: &[(PathBuf, ExrFile)]) -> Result<(RenderOutput, Vec<(String,
         }
         let names: std::collections::BTreeSet<&str> =
             first.metadata.iter().chain(&tile.metadata).map(|(k, _)| k.as_str()).collect();
-        for name in names {
+        for name in names.into_iter().filter(|n| !PER_TILE.contains(n)) {
             let (a, b) = (value(&first.metadata, name), value(&tile.metadata, name));
             if a != b {
                 let show = |v: Option<&str>| v.unwrap_or("(none)").to_string();
@@ -154,7 +160,15 @@ pub fn merge(tiles: &[(PathBuf, ExrFile)]) -> Result<(RenderOutput, Vec<(String,
     // The merged frame is the tiles' raw radiance: a tile denoised alone
     // would show its edges (`quadray denoise` of the merged frame denoises
     // it whole).
-    let metadata = first.metadata.iter().filter(|(k, _)| k != crate::output::METADATA_DENOISED).cloned().collect();
+    // The device and driver are kept where every tile names the same.
+    let same_everywhere = |k: &str| tiles.iter().all(|(_, t)| value(&t.metadata, k) == value(&first.metadata, k));
+    let metadata = first
+        .metadata
+        .iter()
+        .filter(|(k, _)| k != crate::output::METADATA_DENOISED)
+        .filter(|(k, _)| !PER_TILE.contains(&k.as_str()) || same_everywhere(k))
+        .cloned()
+        .collect();
     Ok((out, metadata))
 }
 

@@ -95,6 +95,11 @@ pub const METADATA_FRAME: &str = "quadray.frame";
 /// Metadata name: the backend every tracing pass ran on (`ray-query` or
 /// `pipeline`).
 pub const METADATA_BACKEND: &str = "quadray.backend";
+/// Metadata name: the Vulkan device that rendered.
+pub const METADATA_DEVICE: &str = "quadray.device";
+/// Metadata name: its driver and version ("llvmpipe: Mesa 26.2.6-1 (LLVM
+/// 22.1.8)"): which Mesa and LLVM ran.
+pub const METADATA_DRIVER: &str = "quadray.driver";
 /// Metadata name: how the image was denoised (library, version, quality,
 /// time), when it was: its RGB is the denoised image, `noisy.RGB` the raw.
 pub const METADATA_DENOISED: &str = "quadray.denoised";

@@ -2,6 +2,7 @@
 //! `indicatif`.
 
 use std::io::{IsTerminal, Write};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressDrawTarget, ProgressStyle, TermLike};
@@ -13,8 +14,20 @@ use indicatif::{ProgressDrawTarget, ProgressStyle, TermLike};
 pub struct ProgressBar {
     bar: indicatif::ProgressBar,
     start: Instant,
-    target: Option<ProgressDrawTarget>,
+    /// Where it draws, until it is shown.
+    target: Arc<Mutex<Option<ProgressDrawTarget>>>,
+    /// Whether it still shows [`COMPILING`] instead of the bar.
+    compiling: bool,
 }
+
+/// What the line says before the first unit of work is done, where
+/// [`ProgressBar::compiling`] asks for it: a Vulkan driver may compile the
+/// shaders at their first dispatch (lavapipe does), for seconds to a minute
+/// the first time a variant is used and never again (its shader cache).
+pub const COMPILING: &str = "compiling shaders (first use of this variant)";
+
+/// The bar's template.
+const BAR: &str = "[{bar:30}] {percent:>3}%  {elapsed} elapsed, {eta} left {msg}";
 
 /// Draws on stderr as lines: for logs, where cursor movement would leave
 /// control characters.
@@ -66,12 +79,28 @@ impl ProgressBar {
             None
         };
         let bar = indicatif::ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
-        bar.set_style(
-            ProgressStyle::with_template("[{bar:30}] {percent:>3}%  {elapsed} elapsed, {eta} left {msg}")
-                .expect("a valid template")
-                .progress_chars("#> "),
-        );
-        Self { bar, start: Instant::now(), target }
+        bar.set_style(ProgressStyle::with_template(BAR).expect("a valid template").progress_chars("#> "));
+        Self { bar, start: Instant::now(), target: Arc::new(Mutex::new(target)), compiling: false }
+    }
+
+    /// Until the first [`ProgressBar::update`], the line says [`COMPILING`]
+    /// with the time elapsed (redrawn every second from a thread, since the
+    /// work reports nothing while the driver compiles), shown after a
+    /// second as the bar is.
+    pub fn compiling(mut self) -> Self {
+        self.compiling = true;
+        self.bar.set_style(ProgressStyle::with_template("{spinner} {msg}: {elapsed}").expect("a valid template"));
+        self.bar.set_message(COMPILING);
+        let (bar, target) = (self.bar.clone(), self.target.clone());
+        std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_secs(1));
+            let Ok(mut target) = target.lock() else { return };
+            if let Some(t) = target.take() {
+                bar.set_draw_target(t);
+                bar.enable_steady_tick(Duration::from_secs(1));
+            }
+        });
+        self
     }
 
     /// Text shown after the bar (what is being done now).
@@ -84,10 +113,16 @@ impl ProgressBar {
         if total == 0 {
             return;
         }
+        if self.compiling {
+            self.compiling = false;
+            self.bar.disable_steady_tick();
+            self.bar.set_style(ProgressStyle::with_template(BAR).expect("a valid template").progress_chars("#> "));
+            self.bar.set_message("");
+        }
         self.bar.set_length(total);
         self.bar.set_position(done.min(total));
         if self.start.elapsed() >= Duration::from_secs(1) {
-            if let Some(target) = self.target.take() {
+            if let Some(target) = self.target.lock().ok().and_then(|mut t| t.take()) {
                 self.bar.set_draw_target(target);
             }
         }
@@ -95,6 +130,11 @@ impl ProgressBar {
 
     /// Ends the bar's line, if it was shown.
     pub fn finish(&self) {
+        // A line not shown yet never will be.
+        if let Ok(mut t) = self.target.lock() {
+            t.take();
+        }
+        self.bar.disable_steady_tick();
         if !self.bar.is_hidden() {
             self.bar.finish();
         }

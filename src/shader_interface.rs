@@ -112,7 +112,7 @@ pub const INTERSECT_BASE: u32 = 2;
 /// Shading mode: the path tracer (the renderer's mode).
 pub const SHADING_FULL: u32 = 0;
 /// Shading mode: the first hit's albedo only (benchmark breakdowns).
-pub const SHADING_NONE: u32 = 1;
+pub const SHADING_ALBEDO: u32 = 1;
 /// Shading mode: the albedo of the first hit that is not a perfect mirror,
 /// seen through perfect mirrors (times their reflectance); no lighting. With
 /// many samples per pixel and no filtering it is the exact pixel average of
@@ -126,10 +126,11 @@ pub const SHADING_GLOSSY_ALBEDO: u32 = 3;
 /// Texture filtering: bilinear lookups of mip level 0 (with many samples per
 /// pixel, the brute-force reference).
 pub const FILTER_NONE: u32 = 0;
-/// Texture filtering: ray cones (Akenine-Möller et al. 2021) with EWA lookups.
+/// Texture filtering: ray cones (Akenine-Möller et al. 2021), a few
+/// trilinear probes along the footprint (EWA is the reference lookup).
 pub const FILTER_RAY_CONES: u32 = 1;
 /// Texture filtering: covariance footprints carried along the path (the
-/// paper's method), with EWA lookups.
+/// paper's method), read by the same probes.
 pub const FILTER_COVARIANCE: u32 = 2;
 /// Texture lookup of the filtered modes: trilinear probes along the
 /// footprint's major axis (texfilter.glsl, probeLookup; the default).

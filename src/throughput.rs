@@ -192,6 +192,8 @@ fn render(
     output: &Path,
 ) -> Result<Run, ThroughputError> {
     let mut cmd = Command::new(binary);
+    // Each binary chooses its Vulkan driver from the user's environment.
+    crate::vk::runtime::restore_env(&mut cmd);
     cmd.arg("render");
     if scene != "default" {
         cmd.arg(scene);
@@ -266,8 +268,11 @@ pub fn run(config: &Config) -> Result<Report, ThroughputError> {
         h.to_string(),
         "--spp".into(),
         config.spp.to_string(),
+        // Samples are measured, not the denoiser (the default scene asks for it).
+        "--no-denoise".into(),
     ];
-    let warm_flags: Vec<String> = ["--width", "64", "--height", "48", "--spp", "1"].map(String::from).to_vec();
+    let warm_flags: Vec<String> =
+        ["--width", "64", "--height", "48", "--spp", "1", "--no-denoise"].map(String::from).to_vec();
     // What is measured: (name, binary, extra flags).
     let mut binaries: Vec<(&str, PathBuf, Vec<String>)> = if config.backends {
         ["ray-query", "pipeline"]
@@ -325,6 +330,7 @@ pub fn run(config: &Config) -> Result<Report, ThroughputError> {
                         spp.to_string(),
                         "--seed".into(),
                         "77777".into(),
+                        "--no-denoise".into(),
                     ];
                     render(config, &config.binary, scene, &reference_flags, &path)?;
                 }

@@ -29,20 +29,20 @@ pub(crate) struct ThroughputArgs {
     #[arg(long)]
     pub(crate) backends: bool,
     /// Image width of the timed renders.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
+    #[arg(long, default_value_t = 1024, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) width: u32,
     /// Image height of the timed renders.
-    #[arg(long, default_value_t = 768, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
+    #[arg(long, default_value_t = 768, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) height: u32,
     /// Samples per pixel of the timed renders.
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, default_value_t = 16, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
     pub(crate) spp: u32,
     /// Timed renders per binary and scene (alternated between the binaries).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=100))]
     pub(crate) runs: u32,
     /// Also render a reference of this many samples per pixel (another seed;
     /// cached) and report each binary's relative MSE and FLIP against it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
     pub(crate) reference_spp: Option<u32>,
     /// Output folder (created if missing).
     #[arg(short, long, default_value = "results/throughput")]
@@ -61,13 +61,13 @@ pub(crate) struct BenchArgs {
     pub(crate) presets: Vec<Preset>,
     /// Image width of every render (the scenes' own sizes make the
     /// references slow on a CPU driver).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) width: u32,
     /// Image height of every render.
-    #[arg(long, default_value_t = 192, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
+    #[arg(long, default_value_t = 192, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) height: u32,
     /// Samples per pixel of the reference (default: the `reference` preset's 1024).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
     pub(crate) reference_spp: Option<u32>,
     /// Output folder (created if missing); references are cached in its `cache/`.
     #[arg(short, long, default_value = "results/bench")]
@@ -101,22 +101,22 @@ pub(crate) struct FilterBenchArgs {
     #[arg(short, long, default_value = "results/filtering")]
     pub(crate) out: PathBuf,
     /// Image width.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(8..=4096))]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub(crate) width: u32,
     /// Image height.
-    #[arg(long, default_value_t = 192, value_parser = clap::value_parser!(u32).range(8..=4096))]
+    #[arg(long, default_value_t = 192, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub(crate) height: u32,
     /// Samples per pixel of the reference (filtering `none`), rendered as two
     /// halves with different seeds so that its own noise is measured and
     /// subtracted from every error.
-    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(2..=1_000_000))]
+    #[arg(long, default_value_t = 2048, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(2..=quadray::scene::MAX_SPP))]
     pub(crate) reference_spp: u32,
     /// Each mode renders at 1, 2, 4, … up to this many samples per pixel.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, default_value_t = 64, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub(crate) max_spp: u32,
     /// Independent renders (seeds) per measured point: the error splits into
     /// variance (across them) and bias².
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
+    #[arg(long, default_value_t = 8, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(2..=1024))]
     pub(crate) seeds: u32,
     /// The targets: `none`'s error at these spp (each must be on the spp
     /// ladder up to --max-spp), comma-separated.
@@ -126,10 +126,10 @@ pub(crate) struct FilterBenchArgs {
     #[arg(long, default_value_t = 6)]
     pub(crate) frames: u32,
     /// Samples per pixel of each mode's pan frames.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub(crate) frame_spp: u32,
     /// Samples per pixel of the reference pan frames.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
     pub(crate) reference_frame_spp: u32,
     /// Camera motion per pan frame, as a fraction of the camera's distance to
     /// its look-at point, along its right vector (0.004 is about a pixel at
@@ -300,7 +300,7 @@ pub(crate) fn throughput(args: ThroughputArgs, set_threads: bool) -> Result<()> 
         size: (args.width, args.height),
         spp: args.spp,
         runs: args.runs,
-        binary: std::env::current_exe().context("cannot find this binary's path")?,
+        binary: quadray::vk::runtime::current_exe().context("cannot find this binary's path")?,
         baseline: args.baseline,
         backends: args.backends,
         reference_spp: args.reference_spp,
@@ -340,7 +340,7 @@ pub(crate) struct OutliersArgs {
     /// region (the pixels that see one object, silhouettes left out): a
     /// whole-image error far above the mean of the regions' says that a few
     /// pixels dominate it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
     pub(crate) regions: Option<u32>,
     /// Enable the Khronos validation layer; the command fails if it reports errors.
     #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use clap::Parser;
 use quadray::output::{ExrPrecision, OutputKind};
 use quadray::scene::MAX_IMAGE_SIZE;
@@ -13,10 +13,10 @@ use quadray::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT
 #[derive(Parser, Debug, Default, Clone)]
 pub(crate) struct FrameArgs {
     /// Image width in pixels (overrides `image.width`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) width: Option<u32>,
     /// Image height in pixels (overrides `image.height`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) height: Option<u32>,
     /// Random seed (overrides `image.seed`).
     #[arg(long)]
@@ -66,6 +66,36 @@ pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The files `-o output` asks for, each checked before any work: `output`
+/// is not a folder, every folder on the way exists and is one, and a probe
+/// file can be created (and is removed) in it. Errors name what is wrong.
+pub(crate) fn checked_outputs(output: &Path) -> Result<Vec<PathBuf>> {
+    if output.is_dir() || output.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
+        bail!("-o {}: give a file name (e.g. {}/render), not a folder", output.display(), output.display());
+    }
+    let outputs = output_paths(output);
+    let dir = match output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(d) => d.to_path_buf(),
+        None => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        // The nearest ancestor that exists says why.
+        match dir.ancestors().skip(1).find(|a| !a.as_os_str().is_empty() && a.exists()) {
+            _ if dir.exists() => bail!("-o {}: {} is a file, not a folder", output.display(), dir.display()),
+            Some(a) if !a.is_dir() => bail!("-o {}: {} is a file, not a folder", output.display(), a.display()),
+            _ => bail!("-o {}: the output folder {} does not exist", output.display(), dir.display()),
+        }
+    }
+    let probe = dir.join(format!(".quadray-write-test-{}", std::process::id()));
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+        }
+        Err(e) => bail!("-o {}: cannot write in the folder {}: {e}", output.display(), dir.display()),
+    }
+    Ok(outputs)
+}
+
 /// Which files `-o` asks for.
 pub(crate) fn output_paths(output: &Path) -> Vec<PathBuf> {
     match output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
@@ -98,16 +128,17 @@ pub(crate) fn output_files(paths: &[PathBuf], exposure: f32, half: bool) -> Vec<
 #[derive(Parser, Debug, Default, Clone)]
 pub(crate) struct QualityArgs {
     /// Quality preset: `preview`, `interactive`, `final` or `reference`
-    /// (README.md, "Quality presets"). Replaces all the scene's quality
-    /// settings (spp, max_depth, filter, caustic rays and light samples,
-    /// volume samples); the flags below override single ones.
+    /// (docs/presets.md). Replaces all the scene's quality settings (spp,
+    /// max_depth, filter, caustic rays and light samples, volume samples,
+    /// denoising: `preview` and `interactive` denoise, `final` and
+    /// `reference` do not); the flags below override single ones.
     #[arg(long)]
     pub(crate) preset: Option<Preset>,
     /// Samples per pixel (overrides the scene's or preset's `image.spp`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
     pub(crate) spp: Option<u32>,
     /// Longest light path in bounces (overrides `image.max_depth`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub(crate) max_depth: Option<u32>,
     /// Texture filtering (overrides `image.filter`): `none` (bilinear lookups
     /// of the finest mip level; with many samples per pixel, the reference),
@@ -120,15 +151,15 @@ pub(crate) struct QualityArgs {
     pub(crate) filter: Option<FilterMode>,
     /// Caustic rays per light and light sample (overrides `caustics.rays`; 0
     /// switches the caustic passes off).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16_777_216))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..=16_777_216))]
     pub(crate) caustic_rays: Option<u32>,
     /// Points on each sphere light that emit caustic rays (overrides
     /// `caustics.light_samples`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub(crate) caustic_light_samples: Option<u32>,
     /// Camera rays per pixel and render sample of the volume pass (overrides
     /// `volume.samples`; 0 switches the volume pass off).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=65536))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(0..=65536))]
     pub(crate) volume_samples: Option<u32>,
     /// Denoise the finished image with Intel Open Image Denoise (overrides
     /// `image.denoise`; the `preview` and `interactive` presets denoise).

@@ -47,6 +47,14 @@ fn yes(flag: bool) -> &'static str {
 
 /// `quadray devices`.
 pub(crate) fn devices(args: DevicesArgs) -> Result<()> {
+    let driver = quadray::vk::runtime::driver();
+    if !args.json {
+        let hint = match driver {
+            quadray::vk::runtime::Driver::Runtime(_) => " (--system-vulkan for the system's)",
+            quadray::vk::runtime::Driver::System => "",
+        };
+        println!("Vulkan: {}{hint}", quadray::vk::runtime::describe(&driver));
+    }
     let quadray::vk::Survey { devices, auto } = quadray::vk::survey().context("cannot list the Vulkan devices")?;
     if args.json {
         let report = Report {

@@ -55,7 +55,7 @@ pub(crate) struct FarmSlurmArgs {
     /// Scene file (TOML, see scenes/README.md).
     pub(crate) scene: PathBuf,
     /// Tiles per frame (`render --tile i/N`: bands of whole rows).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) tiles: u32,
     /// Frames of the scene's camera animation, A-B or A-B:STEP; without it,
     /// the still camera.
@@ -65,7 +65,7 @@ pub(crate) struct FarmSlurmArgs {
     #[arg(short, long)]
     pub(crate) output: PathBuf,
     /// CPUs per task (`sbatch --cpus-per-task`; lavapipe runs two threads per CPU).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub(crate) cpus_per_task: u32,
     /// Seconds between a task's checkpoints (what a task killed without
     /// warning loses at most; SIGTERM writes one at once).
@@ -117,7 +117,7 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
                 tiles: args.tiles,
                 frames,
                 render_args: args.render_args,
-                quadray: std::env::current_exe().context("cannot find the quadray binary")?,
+                quadray: quadray::vk::runtime::current_exe().context("cannot find the quadray binary")?,
                 cpus_per_task: args.cpus_per_task,
                 checkpoint_every: args.checkpoint_every,
                 sbatch_args: args.sbatch_args,

@@ -24,6 +24,7 @@ pub(crate) struct MergeArgs {
 
 /// `quadray merge`: tiles into the whole frame.
 pub(crate) fn merge(args: MergeArgs) -> Result<()> {
+    let outputs = checked_outputs(&args.output)?;
     let tiles =
         args.tiles.iter().map(|p| Ok((p.clone(), quadray::output::read_render_exr(p)?))).collect::<Result<Vec<_>>>()?;
     let (out, metadata) = quadray::merge::merge(&tiles)?;
@@ -38,7 +39,7 @@ pub(crate) fn merge(args: MergeArgs) -> Result<()> {
         .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
         .and_then(|(_, v)| v.parse().ok())
         .unwrap_or(0.0);
-    let files = output_files(&output_paths(&args.output), exposure, args.half);
+    let files = output_files(&outputs, exposure, args.half);
     write_outputs_with(&out, &files, &metadata)?;
     let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
     eprintln!("merged {} tiles into {} ({}x{}, {} spp)", tiles.len(), names.join(", "), out.width, out.height, out.spp);
@@ -54,8 +55,10 @@ pub(crate) struct DenoiseArgs {
     /// Output path, as `render -o`: `NAME.png`, `NAME.exr`, or a name
     /// without those extensions for both. The EXR keeps every channel of
     /// the input, with RGB denoised and the raw radiance as `noisy.RGB`.
+    /// Default: the input's name with `-denoised` (`a.exr`: `a-denoised.png`
+    /// and `a-denoised.exr`).
     #[arg(short, long)]
-    pub(crate) output: PathBuf,
+    pub(crate) output: Option<PathBuf>,
     /// The denoiser's quality: `fast`, `balanced` or `high`.
     #[arg(long, default_value_t = quadray::denoise::DenoiseQuality::High)]
     pub(crate) quality: quadray::denoise::DenoiseQuality,
@@ -64,8 +67,38 @@ pub(crate) struct DenoiseArgs {
     pub(crate) half: bool,
 }
 
+/// Fails unless `path` is an OpenEXR file (its magic number), naming what
+/// it is instead of the EXR reader's "file identifier missing".
+fn require_exr(path: &Path) -> Result<()> {
+    let mut magic = [0u8; 4];
+    let read = std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
+        .with_context(|| format!("cannot read {}", path.display()));
+    read?;
+    if magic != [0x76, 0x2f, 0x31, 0x01] {
+        let what = match magic {
+            [0x89, b'P', b'N', b'G'] => "a PNG image",
+            [0xff, 0xd8, 0xff, _] => "a JPEG image",
+            _ => "not an OpenEXR file",
+        };
+        bail!(
+            "{} is {what}: `quadray denoise` reads a render's EXR (written by `quadray render`, with its albedo \
+             and normal channels)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// `quadray denoise`: an existing render denoised.
 pub(crate) fn denoise(args: DenoiseArgs) -> Result<()> {
+    let out_name = args.output.clone().unwrap_or_else(|| {
+        let mut name = args.input.with_extension("").into_os_string();
+        name.push("-denoised");
+        PathBuf::from(name)
+    });
+    let outputs = checked_outputs(&out_name)?;
+    require_exr(&args.input)?;
     let mut denoiser = quadray::denoise::Denoiser::load()?;
     let quadray::output::ExrFile { mut output, mut metadata } = quadray::output::read_render_exr(&args.input)
         .with_context(|| format!("cannot read {} as a render", args.input.display()))?;
@@ -76,7 +109,7 @@ pub(crate) fn denoise(args: DenoiseArgs) -> Result<()> {
         );
         output.aov.clear();
     }
-    let done = super::render::denoise_into(&mut denoiser, &mut output, args.quality)?;
+    let (done, seconds) = super::render::denoise_into(&mut denoiser, &mut output, args.quality)?;
     let exposure = metadata
         .iter()
         .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
@@ -84,10 +117,10 @@ pub(crate) fn denoise(args: DenoiseArgs) -> Result<()> {
         .unwrap_or(0.0);
     metadata.retain(|(k, _)| k != quadray::output::METADATA_DENOISED);
     metadata.push((quadray::output::METADATA_DENOISED.to_string(), done.clone()));
-    let files = output_files(&output_paths(&args.output), exposure, args.half);
+    let files = output_files(&outputs, exposure, args.half);
     write_outputs_with(&output, &files, &metadata)?;
     let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
-    eprintln!("denoised: {done}");
+    eprintln!("denoised: {done}; {seconds:.2} s");
     eprintln!("wrote {}", names.join(", "));
     Ok(())
 }

@@ -125,21 +125,8 @@ pub(crate) fn requested_frames(args: &RenderArgs) -> Option<Vec<u32>> {
 
 pub(crate) fn render(args: RenderArgs) -> Result<()> {
     let scene = load(&args)?;
-    if args.output.is_dir() || args.output.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR) {
-        bail!(
-            "-o {}: give a file name (e.g. {}/render), not a directory",
-            args.output.display(),
-            args.output.display()
-        );
-    }
-    let outputs = output_paths(&args.output);
-    for p in &outputs {
-        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if !dir.is_dir() {
-                bail!("output directory {} does not exist", dir.display());
-            }
-        }
-    }
+    // Before any GPU work: a render is never lost to an unwritable output.
+    let outputs = checked_outputs(&args.output)?;
     let frames = requested_frames(&args);
     if frames.as_ref().is_some_and(|f| f.len() > 1) && (args.checkpoint.is_some() || args.resume.is_some()) {
         bail!("--checkpoint and --resume take one frame at a time (--frame F), not a --frames range");
@@ -200,10 +187,12 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
         let first = list[0].map_or_else(|| scene.clone(), |f| scene.at_frame(f));
         // A wrong checkpoint is refused before any GPU work.
         let mut resume = quadray::job::read_resume(&first, variant, &options)?;
+        // The shaders compile from here to the first dispatch's end.
+        let mut first_progress = Some(ProgressBar::new(args.progress).compiling());
         let mut job = quadray::job::Job::new(&ctx, &first, variant, bounds).context("render failed")?;
         for frame in list {
             let frame_scene = frame.map_or_else(|| scene.clone(), |f| scene.at_frame(f));
-            let mut progress = ProgressBar::new(args.progress);
+            let mut progress = first_progress.take().unwrap_or_else(|| ProgressBar::new(args.progress));
             let result = job.render(&frame_scene, &options, resume.take(), &mut |d, t| progress.update(d, t));
             progress.finish();
             let result = result.context("render failed")?;
@@ -271,7 +260,9 @@ pub(crate) fn write_render(
     if let Some(b) = out.backend {
         metadata.push((quadray::output::METADATA_BACKEND.to_string(), b.to_string()));
     }
-    if let Some(d) = &denoised {
+    metadata.push((quadray::output::METADATA_DEVICE.to_string(), ctx.device.name.clone()));
+    metadata.push((quadray::output::METADATA_DRIVER.to_string(), ctx.device.driver.clone()));
+    if let Some((d, _)) = &denoised {
         metadata.push((quadray::output::METADATA_DENOISED.to_string(), d.clone()));
     }
     write_outputs_with(out, &files, &metadata)?;
@@ -324,41 +315,45 @@ pub(crate) fn write_render(
             out.width as u64 * out.height as u64 * out.spp as u64
         );
     }
-    if let Some(d) = &denoised {
-        eprintln!("denoised: {d}");
+    if let Some((d, seconds)) = &denoised {
+        eprintln!("denoised: {d}; {seconds:.2} s");
     }
     let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
     eprintln!(
-        "wrote {} ({}x{}, {} spp, {:.2} s on {})",
+        "wrote {} ({}x{}, {} spp, {:.2} s on {}, driver {})",
         names.join(", "),
         out.width,
         out.height,
         out.spp,
         out.seconds,
-        ctx.device.name
+        ctx.device.name,
+        ctx.device.driver
     );
     Ok(())
 }
 
 /// Denoises `out` in place (its `denoised` image) and returns what was done,
 /// as the metadata and the message say it.
+/// Returns the metadata's description (without the time, so that the same
+/// render denoised twice, or resumed, writes the same bytes) and the
+/// seconds it took.
 pub(crate) fn denoise_into(
     denoiser: &mut quadray::denoise::Denoiser,
     out: &mut quadray::passes::RenderOutput,
     quality: quadray::denoise::DenoiseQuality,
-) -> Result<String> {
+) -> Result<(String, f64)> {
     let start = std::time::Instant::now();
     let features = quadray::denoise::has_features(out);
     out.denoised = Some(quadray::denoise::denoise_output(denoiser, out, quality)?);
     let v = denoiser.version;
-    Ok(format!(
-        "Intel Open Image Denoise {}.{}.{}, {quality} quality, {}; {:.2} s",
+    let what = format!(
+        "Intel Open Image Denoise {}.{}.{}, {quality} quality, {}",
         v / 10000,
         v / 100 % 100,
         v % 100,
         if features { "with the albedo and normal images" } else { "colour only" },
-        start.elapsed().as_secs_f64()
-    ))
+    );
+    Ok((what, start.elapsed().as_secs_f64()))
 }
 
 /// The benchmark mode of `render --bench`; returns the full render.

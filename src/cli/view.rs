@@ -22,14 +22,14 @@ pub(crate) struct ViewArgs {
     #[command(flatten)]
     pub(crate) quality: QualityArgs,
     /// Initial window width (overrides `image.width`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) width: Option<u32>,
     /// Initial window height (overrides `image.height`).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIZE))]
     pub(crate) height: Option<u32>,
     /// Samples per pixel to accumulate before the view stops refining
     /// (default: the preset's or scene's spp).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
     pub(crate) max_spp: Option<u32>,
     /// Start with the caustic and volume passes off (brute force).
     #[arg(long)]
@@ -38,8 +38,10 @@ pub(crate) struct ViewArgs {
     #[arg(long, default_value = ".")]
     pub(crate) screenshot_dir: PathBuf,
     /// Steps to run, separated by `;` (for automation and tests): `wait N`
-    /// (N spp on screen), `frames N`, `screenshot [NAME]`, `key K`,
-    /// `orbit YAW PITCH`, `resize WxH`, `minimize`, `restore`, `close`.
+    /// (N spp on screen), `frames N`, `screenshot [NAME]`, `capture NAME`
+    /// (the window as the X server shows it), `key K`, `orbit YAW PITCH`,
+    /// `resize WxH`, `minimize`, `restore`, `close`. On a machine without a
+    /// display: `xvfb-run -a quadray view --script ...`.
     #[arg(long)]
     pub(crate) script: Option<String>,
     /// Enable the Khronos validation layer; the command fails if it reports errors.

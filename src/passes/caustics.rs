@@ -327,7 +327,14 @@ impl CausticMap {
         let ((), t) = timer.run(cmds, |rec| {
             // The rays start from the G-buffer's receivers.
             rec.barrier(&[tracing], &[tracing]);
-            for g in grids.iter() {
+            for (i, g) in grids.iter().enumerate() {
+                // Each grid writes its own range of the rays; the
+                // synchronisation checks see the whole buffer (1.4 layers),
+                // so the grids are ordered (free on lavapipe, which runs
+                // them in order anyway).
+                if i > 0 {
+                    rec.barrier(&[tracing], &[tracing]);
+                }
                 trace.run(
                     rec.cmd,
                     bytemuck::bytes_of(&CausticPush { emitter: *g }),

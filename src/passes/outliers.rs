@@ -13,7 +13,7 @@
 //! `a L / 2` where `a = f cos / p_b` is the BSDF's weight in that direction,
 //! at most 1 (the albedo for Lambert; tests/sampling/sampling_gpu.rs checks it at
 //! every angle), and `L` the largest emitted radiance. Every vertex, the last included, uses
-//! multiple importance sampling (render.comp: the last vertex still samples
+//! multiple importance sampling (render.glsl: the last vertex still samples
 //! its BSDF and looks for an emitter in that direction), so each vertex adds
 //! at most `1.5 L` times a throughput of at most 1 (smooth interfaces scale
 //! radiance by η², and the product of those factors is 1 for a path from a
@@ -50,7 +50,7 @@ use crate::shader_interface::{
     EVENT_SURFACE, LOBE_INVALID, LOBE_REFLECT, LOBE_TRANSMIT, NO_HIT, NO_TEXTURE,
 };
 
-/// Rec. 709 luminance of linear RGB (the weights render.comp uses).
+/// Rec. 709 luminance of linear RGB (the weights pixel.glsl uses).
 pub fn luminance(c: [f32; 3]) -> f32 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }

@@ -93,7 +93,13 @@ impl ProbePass {
         self.timestamps.reset(rec.cmd);
         self.timestamps.write(rec.cmd, 0);
         let mut first = 0;
+        let written = [Access::ShaderWrite(self.stage())];
         while first < self.count {
+            // Each dispatch writes its own range of the hits; the 1.4
+            // validation layer sees the whole buffer, so they are ordered.
+            if first > 0 {
+                rec.barrier(&written, &written);
+            }
             let n = (self.count - first).min(RAYS_PER_DISPATCH);
             let push = ProbePush { first, count: n };
             self.tracer.run(rec.cmd, bytemuck::bytes_of(&push), [n, 1], [PROBE_GROUP, 1]);

@@ -1,6 +1,7 @@
-//! The render pass: for every sample and every tile, one dispatch that traces
-//! camera rays and lights the first hit directly (render.comp). Tiles keep
-//! each submission short; progress is reported after each.
+//! The render pass: for every sample and every tile, one dispatch that
+//! traces a path from every pixel of the tile (glsl/render.comp, the path
+//! tracer of glsl/render.glsl). Tiles keep each submission short; progress
+//! is reported after each.
 
 use std::sync::Arc;
 
@@ -56,7 +57,7 @@ pub fn render(
 
 /// The pixel filter of every mode and of the reference: a Gaussian of this
 /// σ, in pixels (pbrt-v4's default Gaussian filter has the same σ). The
-/// camera rays sample it (render.comp, cameraJitter); the filtered modes
+/// camera rays sample it (camera.glsl, cameraJitter); the filtered modes
 /// split it between jitter and footprint.
 pub const PIXEL_FILTER_SIGMA: f32 = 0.5;
 
@@ -695,7 +696,7 @@ fn caustic_map(
     }
     // A caustic path from the camera: the receiver (a bounce), the specular
     // vertices (a bounce each, the last vertex included), then the light
-    // found by the segment after them (render.comp, "the last vertex").
+    // found by the segment after them (render.glsl, "the last vertex").
     let Some(mut grids) = emitters(scene, gpu.origin, max_depth - 1, scene.caustics.rays) else {
         log::warn!("a light is inside the bounds of the specular objects: caustics are left to the path tracer");
         return Ok(None);

@@ -59,6 +59,11 @@ impl TexProbePass {
             rec.barrier(&written, &written);
             let mut first = 0;
             while first < self.count {
+                // Each dispatch writes its own range (ordered for the 1.4
+                // validation layer, which sees the whole buffer).
+                if first > 0 {
+                    rec.barrier(&written, &written);
+                }
                 let n = (self.count - first).min(QUERIES_PER_DISPATCH);
                 let push = ProbePush { first, count: n };
                 self.pipeline.dispatch(rec.cmd, bytemuck::bytes_of(&push), [n.div_ceil(PROBE_GROUP), 1, 1]);

@@ -6,7 +6,7 @@
 
 use crate::shader_interface::{
     INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, LOOKUP_EWA, LOOKUP_PROBES, SAMPLER_INDEPENDENT, SAMPLER_SOBOL,
-    SHADING_FULL, SHADING_GLOSSY_ALBEDO, SHADING_MIRRORED_ALBEDO, SHADING_NONE,
+    SHADING_ALBEDO, SHADING_FULL, SHADING_GLOSSY_ALBEDO, SHADING_MIRRORED_ALBEDO,
 };
 use crate::vk::Backend;
 
@@ -55,7 +55,7 @@ impl ShadingMode {
     pub fn constant(self) -> u32 {
         match self {
             Self::Full => SHADING_FULL,
-            Self::Albedo => SHADING_NONE,
+            Self::Albedo => SHADING_ALBEDO,
             Self::MirroredAlbedo => SHADING_MIRRORED_ALBEDO,
             Self::GlossyAlbedo => SHADING_GLOSSY_ALBEDO,
         }

@@ -115,7 +115,12 @@ impl VolumeLight {
             let ((), t) = timer.run(cmds, |rec| {
                 // The maps: the last pass's gathering read them.
                 rec.barrier(&[read], &[write]);
-                for &light in &self.lights {
+                for (i, &light) in self.lights.iter().enumerate() {
+                    // Each light writes its own map; the 1.4 validation
+                    // layer sees the whole buffer, so they are ordered.
+                    if i > 0 {
+                        rec.barrier(&[write], &[write]);
+                    }
                     let push = LightMapPush { pass, passes, light, map_size: size };
                     self.maps.run(rec.cmd, bytemuck::bytes_of(&push), [size, size], [RENDER_GROUP, RENDER_GROUP]);
                 }

@@ -12,7 +12,7 @@ pub use crate::geometry::uv::{UvMapping, UvSettings};
 use crate::geometry::FunctionalObject;
 pub use crate::texture::TextureImage;
 
-pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME, MAX_IMAGE_SIZE};
+pub use file::{load_scene, parse_scene, SceneError, DEFAULT_SCENE, DEFAULT_SCENE_NAME, MAX_IMAGE_SIZE, MAX_SPP};
 
 /// The longest path a scene may ask for (`image.max_depth`).
 pub const MAX_DEPTH: u32 = file::MAX_DEPTH as u32;

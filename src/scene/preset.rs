@@ -26,9 +26,11 @@ pub enum FilterMode {
     /// the reference.
     #[default]
     None,
-    /// EWA lookups over ray-cone footprints (Akenine-Möller et al. 2021).
+    /// Lookups over ray-cone footprints (Akenine-Möller et al. 2021): a few
+    /// trilinear probes along the footprint's major axis (EWA is the
+    /// reference lookup, `filter-bench --lookup ewa`).
     RayCones,
-    /// EWA lookups over footprints from covariance tracing, carried along
+    /// The same probes over footprints from covariance tracing, carried along
     /// the whole path (the paper's method).
     Covariance,
 }

@@ -56,7 +56,7 @@ pub enum Step {
     WaitFrames(u32),
 }
 
-/// The key bindings, for the help text and the README.
+/// The key bindings, for the help text and docs/viewer.md.
 pub const KEY_HELP: &str = "\
 mouse: left drag orbits, right drag turns the view, wheel dollies
 W A S D: fly forward, left, back, right    Q E: down, up    (arrow keys: orbit)
@@ -112,7 +112,7 @@ impl fmt::Display for ScriptError {
 
 impl std::error::Error for ScriptError {}
 
-/// The script language, for the help text and the README.
+/// The script language, for the help text and docs/viewer.md.
 pub const SCRIPT_HELP: &str = "\
 steps separated by `;` or new lines:
   wait N            until N samples per pixel are on screen (or all the view's samples)

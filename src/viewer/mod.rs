@@ -47,6 +47,12 @@ pub enum ViewerError {
     /// The window system failed.
     #[error("window system: {0}")]
     Window(String),
+    /// No display to open a window on.
+    #[error(
+        "cannot open a window: {0}. On a machine without a display, run the viewer under a virtual X server: \
+         `xvfb-run -a quadray view [SCENE] --script 'wait 16; screenshot; close'` (Xvfb: `make setup`)"
+    )]
+    NoDisplay(String),
     /// Vulkan failed.
     #[error(transparent)]
     Vk(#[from] VkError),
@@ -61,6 +67,16 @@ pub enum ViewerError {
         /// The I/O error.
         source: std::io::Error,
     },
+}
+
+/// A winit message without the source location it starts with ("os error
+/// at /home/.../x11/mod.rs:123: neither WAYLAND_DISPLAY ..." says only
+/// "neither WAYLAND_DISPLAY ...").
+fn without_source_path(message: &str) -> String {
+    match message.find(".rs:").and_then(|i| message[i..].find(": ").map(|j| i + j + 2)) {
+        Some(start) => message[start..].trim_end_matches('.').to_string(),
+        None => message.trim_end_matches('.').to_string(),
+    }
 }
 
 /// How to run the viewer.
@@ -94,7 +110,7 @@ pub struct ViewerSummary {
 
 /// Opens the window and runs until it is closed.
 pub fn run(config: ViewerConfig) -> Result<ViewerSummary, ViewerError> {
-    let event_loop = EventLoop::new().map_err(|e| ViewerError::Window(e.to_string()))?;
+    let event_loop = EventLoop::new().map_err(|e| ViewerError::NoDisplay(without_source_path(&e.to_string())))?;
     let mut app = App::new(config);
     event_loop.run_app(&mut app).map_err(|e| ViewerError::Window(e.to_string()))?;
     let summary = ViewerSummary {

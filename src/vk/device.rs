@@ -45,6 +45,9 @@ pub struct Device {
     pub max_allocation_bytes: u64,
     /// Device name, for messages.
     pub name: String,
+    /// The driver's name and version (`VkPhysicalDeviceDriverProperties`:
+    /// "llvmpipe: Mesa 26.2.6-1 (LLVM 22.1.8)" on lavapipe).
+    pub driver: String,
     /// Ray-tracing pipelines, when the device offers them (enabled then,
     /// for the pipeline backend).
     pub ray_tracing: Option<RayTracing>,
@@ -266,6 +269,7 @@ impl Device {
             accel_properties,
             max_allocation_bytes: maintenance3.max_memory_allocation_size,
             name,
+            driver: format!("{}: {}", caps.driver_name, caps.driver_info),
             ray_tracing,
             ray_query: caps.ray_query,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),

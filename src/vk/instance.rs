@@ -50,6 +50,9 @@ pub struct Instance {
     pub raw: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     counters: Arc<ValidationCounters>,
+    /// The validation layer's Vulkan version (`specVersion`) when it is on:
+    /// what it checks depends on it (tests/render/sync.rs).
+    pub validation_layer_version: Option<u32>,
 }
 
 impl Instance {
@@ -75,15 +78,18 @@ impl Instance {
 
         let mut layers = Vec::new();
         let mut extensions = extra.to_vec();
+        let mut validation_layer_version = None;
+        let mut layer_settings_on = false;
         if validation {
             // SAFETY: a global command of the entry just loaded: it takes no handles, and ash sizes the
             // returned Vec from the count the loader reports.
             let available = unsafe { entry.enumerate_instance_layer_properties() }?;
             let found =
-                available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
-            if !found {
+                available.iter().find(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
+            let Some(found) = found else {
                 return Err(VkError::MissingValidationLayer);
-            }
+            };
+            validation_layer_version = Some(found.spec_version);
             layers.push(VALIDATION_LAYER.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
             // SAFETY: as above; the layer name is a NUL-terminated `&'static CStr` that the loader has just
@@ -94,9 +100,29 @@ impl Instance {
                 return Err(VkError::MissingValidationLayer);
             }
             extensions.push(features.as_ptr());
+            if layer_extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(ash::ext::layer_settings::NAME)) {
+                extensions.push(ash::ext::layer_settings::NAME.as_ptr());
+                layer_settings_on = true;
+            }
         }
         let sync_checks = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
         let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync_checks);
+        // From layer 1.3.292 on, the synchronisation checks ignore what shaders
+        // read and write through descriptors unless this setting is on (it
+        // is off by default: "can produce false positives"); the older
+        // layers always track them and do not know VK_EXT_layer_settings
+        // (chaining it there is an error). With it, the 1.4 layer sees a
+        // dispatch or a traceRays racing a fill (tests/render/sync.rs).
+        let heuristic: vk::Bool32 = vk::TRUE;
+        let mut shader_accesses = vk::LayerSettingEXT::default()
+            .layer_name(VALIDATION_LAYER)
+            .setting_name(c"syncval_shader_accesses_heuristic")
+            .ty(vk::LayerSettingTypeEXT::BOOL32);
+        // One Bool32 value (ash's `values` takes bytes and would count 4).
+        shader_accesses.value_count = 1;
+        shader_accesses.p_values = (&heuristic as *const vk::Bool32).cast();
+        let settings = [shader_accesses];
+        let mut layer_settings = vk::LayerSettingsCreateInfoEXT::default().settings(&settings);
 
         let counters = Arc::new(ValidationCounters::default());
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
@@ -121,9 +147,13 @@ impl Instance {
             // Also report problems in vkCreateInstance / vkDestroyInstance.
             info = info.push_next(&mut messenger_info).push_next(&mut validation_features);
         }
+        if layer_settings_on {
+            info = info.push_next(&mut layer_settings);
+        }
         // SAFETY: `info` and everything it points to (`app`, `layers`, `extensions` and, with validation, the
-        // chained `messenger_info` and `validation_features`, whose extensions are in `extensions`) are
-        // locals alive until the call returns. The names are `&'static CStr`s except those in `extra`, which
+        // chained `messenger_info`, `validation_features` and `layer_settings` (with `settings` and the
+        // `heuristic` value it points to), whose extensions are in `extensions`) are locals alive until the
+        // call returns. The names are `&'static CStr`s except those in `extra`, which
         // must be valid NUL-terminated strings: this safe function cannot check that (the viewer passes
         // ash-window's static names). The messenger's user data points into `counters`, which `Self` keeps
         // past vkDestroyInstance.
@@ -149,7 +179,7 @@ impl Instance {
         } else {
             None
         };
-        Ok(Self { entry, raw, debug, counters })
+        Ok(Self { entry, raw, debug, counters, validation_layer_version })
     }
 
     /// The validation message counters (shared; outlive the instance).

@@ -14,6 +14,7 @@ mod naming;
 mod pipeline;
 pub mod reflect;
 mod rt_pipeline;
+pub mod runtime;
 mod sampler;
 #[cfg(feature = "viewer")]
 mod surface;

@@ -188,7 +188,7 @@ fn normalize(a: [f64; 3]) -> [f64; 3] {
 }
 
 /// What the pixel-centre ray of pixel (x, y) sees in `SPHERE_SCENE`,
-/// computed in f64 from the camera model of README.md: forward (0, 0, -1),
+/// computed in f64 from the camera model of docs/outputs.md: forward (0, 0, -1),
 /// right (1, 0, 0) scaled by tan(fov/2)·aspect, up (0, 1, 0) scaled by
 /// tan(fov/2), pixel centres at i + ½, row 0 at the top.
 struct Expected {
@@ -552,7 +552,7 @@ fn a_missing_output_directory_is_an_error() {
     let missing = outdir.path().join("missing").join("sub");
     let base = missing.join("out");
     let stderr = render_fails(args!["render", &scene, "-o", &base, "--validation"], outdir.path());
-    assert!(stderr.contains(&format!("output directory {} does not exist", missing.display())), "{stderr}");
+    assert!(stderr.contains(&format!("the output folder {} does not exist", missing.display())), "{stderr}");
     assert!(entries(outdir.path()).is_empty(), "files left behind: {:?}", entries(outdir.path()));
 }
 
@@ -861,4 +861,97 @@ fn denoise_keeps_the_raw_image_and_without_the_library_writes_nothing() {
     let mut args = vec!["render", "-o", x.to_str().unwrap(), "--preset", "preview", "--no-denoise"];
     args.extend(small);
     render_ok(&args, e, &missing);
+}
+
+#[test]
+fn quadray_alone_prints_the_usage_and_exits_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = quadray::<&str>(&[], dir.path(), &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("Usage: quadray"), "{stdout}");
+    assert!(stdout.contains("quadray render"), "the usage shows a first command:\n{stdout}");
+    assert!(entries(dir.path()).is_empty(), "bare quadray renders nothing");
+}
+
+#[test]
+fn the_default_render_is_denoised_with_the_raw_radiance_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let stderr = render_ok(&["render", "--width", "32", "--height", "24", "--spp", "2"], dir.path(), &[]);
+    assert!(stderr.contains("denoised: Intel Open Image Denoise"), "{stderr}");
+    assert_eq!(entries(dir.path()), ["render.exr", "render.png"]);
+    let exr = quadray::output::read_render_exr(&dir.path().join("render.exr")).unwrap();
+    assert!(exr.output.denoised.is_some(), "the EXR's RGB is the denoised image, noisy.RGB the raw");
+    assert!(exr.metadata.iter().any(|(k, _)| k == quadray::output::METADATA_DENOISED));
+    // --no-denoise: the raw image alone.
+    render_ok(
+        &["render", "--width", "32", "--height", "24", "--spp", "2", "--no-denoise", "-o", "raw"],
+        dir.path(),
+        &[],
+    );
+    let raw = quadray::output::read_render_exr(&dir.path().join("raw.exr")).unwrap();
+    assert!(raw.output.denoised.is_none());
+}
+
+#[test]
+fn an_unwritable_output_fails_before_any_gpu_work_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    // A folder nobody may write in (even root: sysfs), and a path through a file.
+    let stderr = render_fails(&["render", "-o", "/sys/out"], dir.path());
+    assert!(stderr.contains("-o /sys/out: cannot write in the folder /sys"), "{stderr}");
+    assert!(!stderr.contains("wrote") && !stderr.contains("spp"), "it rendered first:\n{stderr}");
+    assert!(!std::path::Path::new("/sys/out.png").exists());
+    std::fs::write(dir.path().join("afile"), b"x").unwrap();
+    let stderr = render_fails(&["render", "-o", "afile/out"], dir.path());
+    assert!(stderr.contains("afile is a file, not a folder"), "{stderr}");
+    assert_eq!(entries(dir.path()), ["afile"], "no probe or output left");
+}
+
+#[test]
+fn messages_for_common_mistakes_say_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    // A negative sample count is a bad value, not an unknown argument.
+    let stderr = render_fails(&["render", "--spp", "-4"], dir.path());
+    assert!(stderr.contains("-4 is not in 1..=1048576"), "{stderr}");
+    assert!(!stderr.contains("'-- -4'"), "{stderr}");
+    // denoise reads EXRs; a PNG is named as such.
+    std::fs::write(dir.path().join("x.png"), b"\x89PNG\r\n\x1a\n0000").unwrap();
+    let stderr = render_fails(&["denoise", "x.png"], dir.path());
+    assert!(stderr.contains("x.png is a PNG image") && stderr.contains("render's EXR"), "{stderr}");
+    assert!(!stderr.contains("file identifier missing"), "{stderr}");
+    // A user's mistake shows no backtrace, even when RUST_BACKTRACE asks.
+    let out = quadray(&["render", "-o", "/sys/out"], dir.path(), &[("RUST_BACKTRACE", "1")]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(!stderr.contains("Stack backtrace") && !stderr.contains("__libc_start"), "{stderr}");
+    // The viewer without a display names the way out, not winit's source.
+    #[cfg(feature = "viewer")]
+    {
+        let out = Command::new(env!("CARGO_BIN_EXE_quadray"))
+            .args(["view", "--width", "8", "--height", "8"])
+            .current_dir(dir.path())
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .env_remove("WAYLAND_SOCKET")
+            .env("RUST_BACKTRACE", "0")
+            .stdin(Stdio::null())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(stderr.contains("xvfb-run -a quadray view"), "{stderr}");
+        assert!(!stderr.contains(".rs:"), "a source path in the message:\n{stderr}");
+    }
+}
+
+#[test]
+fn denoise_without_an_output_name_writes_beside_its_input() {
+    let dir = tempfile::tempdir().unwrap();
+    render_ok(
+        &["render", "--width", "16", "--height", "12", "--spp", "1", "--no-denoise", "-o", "a.exr"],
+        dir.path(),
+        &[],
+    );
+    render_ok(&["denoise", "a.exr"], dir.path(), &[]);
+    assert_eq!(entries(dir.path()), ["a-denoised.exr", "a-denoised.png", "a.exr"]);
 }

@@ -113,7 +113,9 @@ fn four_tiles_merge_into_the_whole_render() {
     let d = dir.path();
     // 300 x 200: the renderer's own 256-pixel dispatch tiles straddle the
     // bands' edges.
-    let base = ["render", "--width", "300", "--height", "200", "--spp", "3"];
+    // Raw radiance: tiles merge bit for bit (a denoised tile would show its
+    // edges; merge keeps the tiles' raw radiance: `denoised_tiles_merge_into_their_raw_radiance`).
+    let base = ["render", "--width", "300", "--height", "200", "--spp", "3", "--no-denoise"];
     let with = |extra: &[&str]| -> Vec<String> { base.iter().chain(extra).map(|s| s.to_string()).collect() };
     ok(&refs(&with(&["-o", "full"])), d);
     let mut tiles = Vec::new();
@@ -210,4 +212,27 @@ fn a_time_limit_writes_what_it_has_and_a_checkpoint_to_resume() {
     let checkpoint = quadray::passes::Checkpoint::read(&d.join("t.ckpt")).unwrap();
     assert_eq!(checkpoint.accumulation.samples, part.output.spp);
     assert_eq!(checkpoint.target_spp, 4000);
+}
+
+/// The default scene is denoised; its tiles, each denoised alone (in its
+/// own time: the metadata differ), merge into their raw radiance, which is
+/// the raw whole render's.
+#[test]
+fn denoised_tiles_merge_into_their_raw_radiance() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["render", "--width", "64", "--height", "48", "--spp", "2"];
+    let with = |extra: &[&str]| -> Vec<String> { base.iter().chain(extra).map(|s| s.to_string()).collect() };
+    ok(&refs(&with(&["--no-denoise", "-o", "raw.exr"])), d);
+    for i in 0..2 {
+        let log = ok(&refs(&with(&["--tile", &format!("{i}/2"), "-o", &format!("t{i}.exr")])), d);
+        assert!(log.contains("denoised:"), "{log}");
+    }
+    let log = ok(&["merge", "t0.exr", "t1.exr", "-o", "merged.exr"], d);
+    assert!(log.contains("denoised images are left out"), "{log}");
+    let merged = quadray::output::read_render_exr(&d.join("merged.exr")).unwrap();
+    let raw = quadray::output::read_render_exr(&d.join("raw.exr")).unwrap();
+    assert!(merged.output.denoised.is_none());
+    assert!(merged.output.radiance == raw.output.radiance, "the merged radiance is not the raw render's");
+    assert!(!merged.metadata.iter().any(|(k, _)| k == quadray::output::METADATA_DENOISED));
 }

@@ -9,4 +9,5 @@ mod common;
 mod commands;
 mod farm_slurm;
 mod long_renders;
+mod runtime;
 mod viewer;

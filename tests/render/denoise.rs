@@ -10,7 +10,7 @@
 //!   "Denoising").
 //! - The denoised image's mean stays within 2 % of the reference's (the
 //!   denoiser darkens highlights by up to 1.4 %: a bias stated in the
-//!   README's "Denoising").
+//!   docs/denoising.md).
 //! - The denoiser's albedo looks through glass: the floor's checker seen
 //!   through a glass sphere shows in it, where the pixel-centre albedo AOV
 //!   has the glass's own (white).

@@ -161,8 +161,33 @@ fn no_tracing_invocation_uses_half_the_loop_budget() {
     // iterations (81 % of the limit) for 1e5 bumps; the stated bound here is
     // the limit itself, where a limiting driver would cut loops. It misses
     // the half-limit margin (issue 27, docs/stability.md).
+    //
+    // Mesa 25.1 removed the limiter: there (the Vulkan runtime's Mesa 26.2)
+    // the count is a cost, not a risk, and it is larger (94,539: that
+    // driver's BVH hands a far ray more candidates before the nearest), so
+    // it is held below twice the limit, as a regression bound.
     let far = measured(&limb_scene(100_000, 1e6, 1), Backend::RayQuery);
     let share = 100.0 * far.most_edges as f64 / LOOP_LIMIT as f64;
     println!("{:<52} {:>12} {:>10} {share:>8.1}%", "1e5 bumps from 1e6 radii", far.invocations, far.most_edges);
-    assert!(far.most_edges < LOOP_LIMIT, "a far view reached the loop limit: {}", far.most_edges);
+    let driver = common::context().device.driver.clone();
+    let bound = if limits_loops(&driver) { LOOP_LIMIT } else { 2 * LOOP_LIMIT };
+    println!("driver {driver}: far-view bound {bound}");
+    assert!(far.most_edges < bound, "a far view reached {} iterations (bound {bound} on {driver})", far.most_edges);
+}
+
+/// Whether a driver may cut loops at [`LOOP_LIMIT`]: Mesa's gallivm before
+/// 25.1 (and any driver not known to be Mesa).
+fn limits_loops(driver: &str) -> bool {
+    let Some(version) = driver.split("Mesa ").nth(1) else { return true };
+    let mut parts = version.split(['.', '-', ' ']).map(|p| p.parse::<u32>().unwrap_or(0));
+    let (major, minor) = (parts.next().unwrap_or(0), parts.next().unwrap_or(0));
+    (major, minor) < (25, 1)
+}
+
+#[test]
+fn the_loop_limiter_is_known_by_mesa_version() {
+    assert!(limits_loops("llvmpipe: Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)"));
+    assert!(!limits_loops("llvmpipe: Mesa 25.1.0 (LLVM 19.1.7)"));
+    assert!(!limits_loops("llvmpipe: Mesa 26.2.6-1 (LLVM 22.1.8)"));
+    assert!(limits_loops("NVIDIA: 560.35.03"));
 }

@@ -359,8 +359,17 @@ fn material_keys_must_fit_the_type() {
         "material_typo.toml",
         &material("type = \"conductor\"\nrougness = 0.2\n"),
         7,
-        &["materials[0].rougness", "unknown field `rougness`", "`roughness`"],
+        &["materials[0].rougness", "unknown key `rougness`; did you mean `roughness`?", "a conductor material accepts"],
     );
+    // Only the keys of the material's own type are listed.
+    check(
+        "diffuse_typo.toml",
+        &material("albdo = [0.5, 0.5, 0.5]\n"),
+        6,
+        &["materials[0].albdo", "did you mean `albedo`?", "a diffuse material accepts name, type, albedo, emission"],
+    );
+    let e = parse_scene(&material("albdo = [0.5, 0.5, 0.5]\n"), "t.toml").unwrap_err().to_string();
+    assert!(!e.contains("roughness"), "the keys of other types are listed: {e}");
 }
 
 #[test]

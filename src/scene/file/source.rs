@@ -98,6 +98,8 @@ impl Source<'_> {
             // The table header of the array: the path without its indices.
             let header: String = field.split('[').map(|p| p.split_once(']').map_or(p, |(_, rest)| rest)).collect();
             message.push_str(&format!(" (write [[{header}]] with double brackets for each entry)"));
+        } else if let Some(better) = self.unknown_typed_key(&field, &message) {
+            message = better;
         } else if message.starts_with("unknown field `background`") && field.contains('.') {
             message.push_str(
                 " (top-level keys such as `background` must come before the first [table] header, \
@@ -105,6 +107,32 @@ impl Source<'_> {
             );
         }
         self.error(inner.span(), field, message)
+    }
+
+    /// For an unknown key of a material or a light (`materials[2].roughnes`),
+    /// the keys of that table's own type instead of every type's, and the
+    /// nearest one ("did you mean `roughness`?").
+    fn unknown_typed_key(&self, field: &str, message: &str) -> Option<String> {
+        let key = message.strip_prefix("unknown field `")?.split('`').next()?;
+        let (array, rest) = field.split_once('[')?;
+        let (index, key_path) = rest.split_once(']')?;
+        // Only a key of the material or light itself, not of a table in it.
+        if key_path != format!(".{key}") {
+            return None;
+        }
+        let index: usize = index.parse().ok()?;
+        let (types, noun, default): (&[(&str, &[&str])], _, _) = match array {
+            "materials" => (&super::schema::MATERIAL_KEYS, "material", "diffuse"),
+            "lights" => (&super::schema::LIGHT_KEYS, "light", ""),
+            _ => return None,
+        };
+        let doc: toml::Value = toml::from_str(self.text).ok()?;
+        let table = doc.get(array)?.get(index)?;
+        let kind = table.get("type").and_then(|t| t.as_str()).unwrap_or(default);
+        let (_, accepted) = types.iter().find(|(t, _)| *t == kind)?;
+        let nearest = accepted.iter().min_by_key(|k| edit_distance(k, key)).filter(|k| edit_distance(k, key) <= 2);
+        let hint = nearest.map_or(String::new(), |k| format!("did you mean `{k}`? "));
+        Some(format!("unknown key `{key}`; {hint}a {kind} {noun} accepts {}", accepted.join(", ")))
     }
 }
 
@@ -126,4 +154,20 @@ pub(super) trait Number: Copy {
         }
         Self::check(v).map(|()| Self::new(v))
     }
+}
+
+/// Levenshtein distance between two short words.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
 }
