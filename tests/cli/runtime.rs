@@ -26,6 +26,8 @@ fn bundled() -> Option<Runtime> {
 fn quadray(args: &[&str], cwd: &Path, envs: &[(&str, &str)]) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_quadray"));
     restore_env(&mut cmd);
+    // The choice is the test's, not the environment the suite runs in.
+    cmd.env_remove("QUADRAY_SYSTEM_VULKAN").env_remove("QUADRAY_VULKAN_RUNTIME");
     cmd.args(args).current_dir(cwd).stdin(Stdio::null()).env("RUST_BACKTRACE", "0");
     for (k, v) in envs {
         cmd.env(k, v);
@@ -44,6 +46,7 @@ fn chosen_by_quadray(envs: &[(&str, &str)]) -> String {
 fn runner_chooses_a_runtime(envs: &[(&str, &str)]) -> bool {
     let mut cmd = Command::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/vulkan-runtime-run"));
     restore_env(&mut cmd);
+    cmd.env_remove("QUADRAY_SYSTEM_VULKAN").env_remove("QUADRAY_VULKAN_RUNTIME");
     cmd.arg("/usr/bin/env").stdin(Stdio::null());
     for (k, v) in envs {
         cmd.env(k, v);
