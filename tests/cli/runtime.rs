@@ -12,7 +12,6 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use quadray::metrics::{flip_mean, relative_mse};
 use quadray::output::{read_render_exr, METADATA_DRIVER};
 use quadray::vk::runtime::{restore_env, Runtime, BUNDLED_RUNTIME};
 
@@ -184,30 +183,9 @@ fn the_system_driver_renders_the_test_scenes_as_the_runtime_does() {
         if have {
             assert_ne!(d_runtime, d_system, "{name}: the same driver twice");
         }
-        let (a, b) = (&runtime.output, &system.output);
-        let max = a
-            .radiance
-            .iter()
-            .flatten()
-            .zip(b.radiance.iter().flatten())
-            .map(|(&x, &y)| f64::from((x - y).abs()) / f64::from(x.abs()).max(1.0))
-            .fold(0.0, f64::max);
-        let flip = flip_mean(a, b, 0.0).unwrap();
-        let rel = relative_mse(a, b).unwrap();
-        let differing = a
-            .radiance
-            .iter()
-            .zip(&b.radiance)
-            .filter(|(p, q)| {
-                p.iter()
-                    .zip(q.iter())
-                    .any(|(x, y)| f64::from((x - y).abs()) / f64::from(x.abs()).max(1.0) > MAX_CHANNEL_DIFFERENCE)
-            })
-            .count();
-        let pixels = a.radiance.len();
-        println!(
-            "{name:<18} {max:>12.2e} {flip:>10.6} {rel:>12.2e} {differing:>5} of {pixels}   ({d_runtime} / {d_system})"
-        );
+        let d = crate::common::Agreement::of(&runtime.output, &system.output, MAX_CHANNEL_DIFFERENCE);
+        let (flip, differing, pixels) = (d.flip, d.differing, d.pixels);
+        println!("{name:<18} {}   ({d_runtime} / {d_system})", d.row());
         failures.extend((flip > MAX_FLIP).then(|| format!("{name}: FLIP {flip}")));
         let share = differing as f64 / pixels as f64;
         failures

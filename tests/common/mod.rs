@@ -378,3 +378,44 @@ fn record_equal_time(path: &std::path::Path, entry: serde_json::Value) {
     all.sort_by(|a, b| a["scene"].as_str().cmp(&b["scene"].as_str()));
     std::fs::write(path, serde_json::to_string_pretty(&all).unwrap() + "\n").unwrap();
 }
+
+/// How two renders of one scene differ where they should agree to rounding
+/// (two backends, two drivers): the largest channel difference relative to
+/// max(1, the first's value), mean FLIP, relative MSE, and the pixels with a
+/// channel differing by more than `channel_bound` (same measure).
+pub struct Agreement {
+    pub max_channel: f64,
+    pub flip: f64,
+    pub relmse: f64,
+    pub differing: usize,
+    pub pixels: usize,
+}
+
+impl Agreement {
+    pub fn of(a: &quadray::passes::RenderOutput, b: &quadray::passes::RenderOutput, channel_bound: f64) -> Self {
+        let rel = |x: f32, y: f32| f64::from((x - y).abs()) / f64::from(x.abs()).max(1.0);
+        let max_channel =
+            a.radiance.iter().flatten().zip(b.radiance.iter().flatten()).map(|(&x, &y)| rel(x, y)).fold(0.0, f64::max);
+        let differing = a
+            .radiance
+            .iter()
+            .zip(&b.radiance)
+            .filter(|(p, q)| p.iter().zip(q.iter()).any(|(&x, &y)| rel(x, y) > channel_bound))
+            .count();
+        Self {
+            max_channel,
+            flip: quadray::metrics::flip_mean(a, b, 0.0).unwrap(),
+            relmse: quadray::metrics::relative_mse(a, b).unwrap(),
+            differing,
+            pixels: a.radiance.len(),
+        }
+    }
+
+    /// The table row: max channel, FLIP, relMSE, pixels differing.
+    pub fn row(&self) -> String {
+        format!(
+            "{:>12.2e} {:>10.6} {:>12.2e} {:>5} of {}",
+            self.max_channel, self.flip, self.relmse, self.differing, self.pixels
+        )
+    }
+}

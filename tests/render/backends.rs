@@ -10,7 +10,6 @@
 //! device without one of them fails here instead of comparing a backend
 //! with itself.
 
-use quadray::metrics::{flip_mean, relative_mse};
 use quadray::passes::RenderVariant;
 use quadray::vk::Backend;
 
@@ -55,27 +54,9 @@ fn every_test_scene_renders_the_same_with_both_backends() {
         );
         // The outputs say which backend ran: two backends were compared.
         assert_eq!((rq.backend, pipe.backend), (Some(Backend::RayQuery), Some(Backend::Pipeline)), "{name}");
-        let max = rq
-            .radiance
-            .iter()
-            .flatten()
-            .zip(pipe.radiance.iter().flatten())
-            .map(|(&a, &b)| f64::from((a - b).abs()) / f64::from(a.abs()).max(1.0))
-            .fold(0.0, f64::max);
-        let flip = flip_mean(&rq, &pipe, 0.0).unwrap();
-        let rel = relative_mse(&rq, &pipe).unwrap();
-        let pixels = rq.radiance.len();
-        let differing = rq
-            .radiance
-            .iter()
-            .zip(&pipe.radiance)
-            .filter(|(a, b)| {
-                a.iter()
-                    .zip(b.iter())
-                    .any(|(x, y)| f64::from((x - y).abs()) / f64::from(x.abs()).max(1.0) > MAX_CHANNEL_DIFFERENCE)
-            })
-            .count();
-        println!("{name:<22} {max:>12.2e} {flip:>10.6} {rel:>12.2e} {differing:>5} of {pixels}");
+        let d = common::Agreement::of(&rq, &pipe, MAX_CHANNEL_DIFFERENCE);
+        let (flip, differing, pixels) = (d.flip, d.differing, d.pixels);
+        println!("{name:<22} {}", d.row());
         failures.extend((flip > MAX_FLIP).then(|| format!("{name}: FLIP {flip}")));
         let share = differing as f64 / pixels as f64;
         failures.extend((share > MAX_DIFFERING_PIXELS).then(|| format!("{name}: {differing} pixels differ")));
