@@ -79,9 +79,9 @@ pub(crate) fn checked_outputs(output: &Path) -> Result<Vec<PathBuf>> {
         None => PathBuf::from("."),
     };
     if !dir.is_dir() {
-        // The nearest ancestor that exists says why.
-        match dir.ancestors().skip(1).find(|a| !a.as_os_str().is_empty() && a.exists()) {
-            _ if dir.exists() => bail!("-o {}: {} is a file, not a folder", output.display(), dir.display()),
+        // The folder, or the nearest ancestor that exists, says why.
+        let existing = dir.ancestors().find(|a| !a.as_os_str().is_empty() && a.exists());
+        match existing {
             Some(a) if !a.is_dir() => bail!("-o {}: {} is a file, not a folder", output.display(), a.display()),
             _ => bail!("-o {}: the output folder {} does not exist", output.display(), dir.display()),
         }

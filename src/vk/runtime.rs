@@ -208,15 +208,16 @@ pub fn gpu_device() -> Option<PathBuf> {
         .find(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("renderD")))
 }
 
-/// Serialises the current values of `names` for [`SAVED_ENV`].
-fn save(names: &[&str]) -> OsString {
+/// Serialises variables and their values (`None`: unset) in the form of
+/// [`SAVED_ENV`] and [`SET_ENV`].
+fn serialise<'a>(vars: impl IntoIterator<Item = (&'a str, Option<OsString>)>) -> OsString {
     let mut out = OsString::new();
-    for (i, name) in names.iter().enumerate() {
+    for (i, (name, value)) in vars.into_iter().enumerate() {
         if i > 0 {
             out.push("\n");
         }
         out.push(name);
-        if let Some(v) = std::env::var_os(name) {
+        if let Some(v) = value {
             out.push("=");
             out.push(v);
         }
@@ -339,20 +340,10 @@ fn restart(runtime: &Runtime, pid: &str) -> std::io::Error {
     let argv0 = args.next().unwrap_or_else(|| exe.clone().into_os_string());
     let mut cmd = std::process::Command::new(runtime.loader());
     cmd.arg("--argv0").arg(argv0).arg("--library-path").arg(runtime.library_dir()).arg(&exe).args(args);
-    cmd.env(SAVED_ENV, save(&VULKAN_VARS));
-    let mut set = OsString::new();
-    for (i, (name, value)) in runtime.vulkan_env().iter().enumerate() {
-        if i > 0 {
-            set.push("\n");
-        }
-        set.push(name);
-        if let Some(v) = value {
-            set.push("=");
-            set.push(v);
-        }
-    }
-    cmd.env(SET_ENV, set);
-    for (name, value) in runtime.vulkan_env() {
+    cmd.env(SAVED_ENV, serialise(VULKAN_VARS.map(|name| (name, std::env::var_os(name)))));
+    let env = runtime.vulkan_env();
+    cmd.env(SET_ENV, serialise(env.clone()));
+    for (name, value) in env {
         match value {
             Some(v) => cmd.env(name, v),
             None => cmd.env_remove(name),
