@@ -14,12 +14,12 @@
 use std::sync::Arc;
 
 use glam::{DAffine3, DVec3, Vec3};
-use quadray::geometry::{scatter::spread_bumps, CellParams, FunctionalObject, Quadric};
+use quadray::gpu::shader_interface::NO_HIT;
+use quadray::model::geometry::{scatter::spread_bumps, CellParams, FunctionalObject, Quadric};
+use quadray::model::scene::{Camera, ImageSettings, Material, Scene, SceneObject};
 use quadray::passes::gpu::GpuRay;
 use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
-use quadray::scene::{Camera, ImageSettings, Material, Scene, SceneObject};
-use quadray::shader_interface::NO_HIT;
 use quadray::vk::{Commands, Context};
 
 const COUNTS: [usize; 4] = [0, 10, 100, 1000];

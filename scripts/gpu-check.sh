@@ -14,7 +14,8 @@
 #     libstdc++.so.6, which is reported).
 #  2. `quadray devices` and `--json`: the devices, what each offers, the backend auto takes.
 #  3. Every test scene (scenes/tests/*.toml) at 64x48, 4 spp, its own seed,
-#     with each backend the device offers, compared with the lavapipe
+#     with each backend the device offers (and the wavefront pass, on ray
+#     queries: `--kernel wavefront`), compared with the lavapipe
 #     reference (`quadray compare`: FLIP and relative MSE). Bound: FLIP at
 #     most FLIP_BOUND (0.05). On lavapipe the two backends agree to FLIP
 #     0.000000 (tests/render/backends.rs); another GPU rounds sin, exp and
@@ -68,11 +69,14 @@ section "2. devices"
 
 section "3. test scenes against the lavapipe references (FLIP bound $FLIP_BOUND)"
 printf '%-20s %-10s %-10s %s\n' scene backend FLIP "relative MSE"
-for backend in ray-query pipeline; do
+# `wavefront`: ray queries with the wavefront pass (--kernel wavefront).
+for backend in ray-query pipeline wavefront; do
+  flags=(--backend "$backend")
+  [[ $backend == wavefront ]] && flags=(--backend ray-query --kernel wavefront)
   for scene in $(scenes); do
     name=$(basename "$scene" .toml)
     image="$out/$name-$backend.exr"
-    if ! "$bin" render "$scene" "${SIZE[@]}" --backend "$backend" -o "$image" > "$out/$name-$backend.log" 2>&1; then
+    if ! "$bin" render "$scene" "${SIZE[@]}" "${flags[@]}" -o "$image" > "$out/$name-$backend.log" 2>&1; then
       if grep -q "offers no" "$out/$name-$backend.log"; then
         printf '%-20s %-10s %s\n' "$name" "$backend" "not offered by this device"
         break

@@ -2,76 +2,39 @@
 //! (perturbed quadrics), after Vyatkin & Dolgovesov, "Smoothing of
 //! functionally defined objects in scenes with global illumination" (2022).
 //!
-//! - [`geometry`]: the surfaces in f64 on the CPU (bounds, cells, the
-//!   reference intersection).
-//! - [`scene`]: the scene model and its TOML files.
-//! - [`vk`]: the Vulkan backend.
-//! - [`passes`]: GPU passes.
-//! - [`output`]: PNG and EXR files, written atomically.
+//! Eight modules, bottom up (docs/architecture.md, "Layers"; each uses
+//! only its own layer and those below):
+//!
+//! - [`gpu`]: what the host shares with the shaders: binding numbers,
+//!   specialisation constants and enum values, and the compiled SPIR-V.
+//! - [`vk`]: Vulkan through `ash`, one concept a file.
+//! - [`util`]: leaf libraries: atomic files, a stable hash, progress bars,
+//!   Intel Open Image Denoise.
+//! - [`model`]: the CPU model: exact f64 geometry, textures, the scene and
+//!   its TOML files, the f64 twins of the GPU's sampling code.
+//! - [`passes`]: the GPU passes over an uploaded scene (render, caustics,
+//!   volume) and the film they fill.
+//! - [`jobs`]: long renders (checkpoints, tiles, frames), image files,
+//!   merging tiles, Slurm farms.
+//! - [`tools`]: benchmarks, metrics, plots.
+//! - [`viewer`]: the interactive window (feature `viewer`).
 
 // Every `unsafe` block says why it is sound (clippy runs with -D warnings).
 #![warn(clippy::undocumented_unsafe_blocks)]
 
-pub mod bench;
-pub mod covariance;
-pub mod denoise;
-pub mod farm;
-pub mod files;
-pub mod filter_bench;
-pub mod geometry;
-pub mod hash;
-pub mod job;
-pub mod merge;
-pub mod metrics;
-pub mod output;
+pub mod gpu;
+pub mod jobs;
+pub mod model;
 pub mod passes;
-pub mod plot;
-pub mod progress;
-pub mod sampling;
-pub mod scene;
-pub mod shader_interface;
-pub mod shaders;
-pub mod texture;
-pub mod throughput;
+pub mod tools;
+pub mod util;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod vk;
 
-/// Errors of rendering a scene.
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    /// The Vulkan backend failed.
-    #[error(transparent)]
-    Vk(#[from] vk::VkError),
-    /// The scene uses more texture maps than the shader's texture array holds.
-    #[error("the scene uses {0} texture maps; at most {max} are supported", max = shader_interface::MAX_TEXTURES - 1)]
-    TooManyTextures(usize),
-    /// A texture map is too large for the device in every encoding that
-    /// holds its values.
-    #[error(transparent)]
-    TextureTooLarge(#[from] texture::encoding::TextureTooLarge),
-    /// An object cannot be rendered.
-    #[error("object `{object}`: {source}")]
-    Geometry {
-        /// The object's name.
-        object: String,
-        /// What is wrong.
-        source: geometry::GeometryError,
-    },
-    /// Pixel bounds that are empty or outside the frame.
-    #[error(transparent)]
-    Bounds(#[from] passes::film::BoundsError),
-    /// An accumulation that does not fit the renderer (another image size,
-    /// crop or sample target).
-    #[error("the accumulation does not fit this render: {0}")]
-    Accumulation(String),
-}
+use model::scene;
 
-impl From<ash::vk::Result> for RenderError {
-    fn from(e: ash::vk::Result) -> Self {
-        Self::Vk(e.into())
-    }
-}
+pub use passes::RenderError;
 
 /// Uploads `scene` and renders it at its own image settings, reporting
 /// progress as (done, total) work units.

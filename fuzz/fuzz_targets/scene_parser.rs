@@ -8,6 +8,6 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {
         // A name inside a directory without texture files: `file = ...`
         // paths resolve against it and fail to load, as they should.
-        let _ = quadray::scene::parse_scene(text, "fuzz/scene.toml");
+        let _ = quadray::model::scene::parse_scene(text, "fuzz/scene.toml");
     }
 });

@@ -7,11 +7,11 @@ use super::common::*;
 use super::render::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
-use quadray::output::{write_exr, ExrPrecision};
+use quadray::jobs::output::{write_exr, ExrPrecision};
+use quadray::model::scene::MAX_IMAGE_SIZE;
+use quadray::model::scene::{parse_scene, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 use quadray::passes::{LookupMode, ShadingMode};
-use quadray::progress::ProgressBar;
-use quadray::scene::MAX_IMAGE_SIZE;
-use quadray::scene::{parse_scene, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+use quadray::util::progress::ProgressBar;
 
 #[derive(Parser, Debug)]
 pub(crate) struct ThroughputArgs {
@@ -28,6 +28,12 @@ pub(crate) struct ThroughputArgs {
     /// a baseline.
     #[arg(long)]
     pub(crate) backends: bool,
+    /// Measure this binary with each path kernel side by side (`--kernel
+    /// megakernel`, then `--kernel wavefront`, with ray queries, run for
+    /// run) instead of beside a baseline; the speed-up column is the
+    /// megakernel's over the wavefront pass's.
+    #[arg(long, conflicts_with_all = ["backends", "baseline"])]
+    pub(crate) kernels: bool,
     /// Image width of the timed renders.
     #[arg(long, default_value_t = 1024, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) width: u32,
@@ -35,14 +41,14 @@ pub(crate) struct ThroughputArgs {
     #[arg(long, default_value_t = 768, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) height: u32,
     /// Samples per pixel of the timed renders.
-    #[arg(long, default_value_t = 16, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
+    #[arg(long, default_value_t = 16, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::model::scene::MAX_SPP))]
     pub(crate) spp: u32,
     /// Timed renders per binary and scene (alternated between the binaries).
     #[arg(long, default_value_t = 3, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=100))]
     pub(crate) runs: u32,
     /// Also render a reference of this many samples per pixel (another seed;
     /// cached) and report each binary's relative MSE and FLIP against it.
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::model::scene::MAX_SPP))]
     pub(crate) reference_spp: Option<u32>,
     /// Output folder (created if missing).
     #[arg(short, long, default_value = "results/throughput")]
@@ -67,7 +73,7 @@ pub(crate) struct BenchArgs {
     #[arg(long, default_value_t = 192, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(8..=MAX_IMAGE_SIZE))]
     pub(crate) height: u32,
     /// Samples per pixel of the reference (default: the `reference` preset's 1024).
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::model::scene::MAX_SPP))]
     pub(crate) reference_spp: Option<u32>,
     /// Output folder (created if missing); references are cached in its `cache/`.
     #[arg(short, long, default_value = "results/bench")]
@@ -109,7 +115,7 @@ pub(crate) struct FilterBenchArgs {
     /// Samples per pixel of the reference (filtering `none`), rendered as two
     /// halves with different seeds so that its own noise is measured and
     /// subtracted from every error.
-    #[arg(long, default_value_t = 2048, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(2..=quadray::scene::MAX_SPP))]
+    #[arg(long, default_value_t = 2048, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(2..=quadray::model::scene::MAX_SPP))]
     pub(crate) reference_spp: u32,
     /// Each mode renders at 1, 2, 4, … up to this many samples per pixel.
     #[arg(long, default_value_t = 64, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
@@ -129,7 +135,7 @@ pub(crate) struct FilterBenchArgs {
     #[arg(long, default_value_t = 4, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub(crate) frame_spp: u32,
     /// Samples per pixel of the reference pan frames.
-    #[arg(long, default_value_t = 256, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::model::scene::MAX_SPP))]
     pub(crate) reference_frame_spp: u32,
     /// Camera motion per pan frame, as a fraction of the camera's distance to
     /// its look-at point, along its right vector (0.004 is about a pixel at
@@ -195,7 +201,7 @@ pub(crate) fn filter_bench(args: FilterBenchArgs) -> Result<()> {
         }
     }
     let command = std::iter::once("quadray".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
-    let config = quadray::filter_bench::Config {
+    let config = quadray::tools::filter_bench::Config {
         scenes: args.scenes,
         out_dir: args.out,
         width: args.width,
@@ -217,14 +223,14 @@ pub(crate) fn filter_bench(args: FilterBenchArgs) -> Result<()> {
         command,
     };
     if args.summarize_only {
-        quadray::filter_bench::summarize(&config)?;
+        quadray::tools::filter_bench::summarize(&config)?;
         return Ok(());
     }
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
-    let reports = quadray::filter_bench::run(&ctx, &config)?;
+    let reports = quadray::tools::filter_bench::run(&ctx, &config)?;
     for r in &reports {
-        for e in quadray::filter_bench::headline_entries(r) {
+        for e in quadray::tools::filter_bench::headline_entries(r) {
             let speedups = e
                 .speedup_vs_none
                 .iter()
@@ -243,7 +249,7 @@ pub(crate) fn filter_bench(args: FilterBenchArgs) -> Result<()> {
 
 pub(crate) fn bench_presets(args: BenchArgs) -> Result<()> {
     if args.replot {
-        quadray::bench::replot(&args.out)?;
+        quadray::tools::bench::replot(&args.out)?;
         eprintln!("wrote {}/bench.png", args.out.display());
         return Ok(());
     }
@@ -258,10 +264,10 @@ pub(crate) fn bench_presets(args: BenchArgs) -> Result<()> {
             (stem, text, name.clone())
         };
         let scene = parse_scene(&source, &file)?;
-        scenes.push(quadray::bench::BenchScene { name: scene_name, scene, source });
+        scenes.push(quadray::tools::bench::BenchScene { name: scene_name, scene, source });
     }
     let command = std::iter::once("quadray".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
-    let config = quadray::bench::Config {
+    let config = quadray::tools::bench::Config {
         scenes,
         presets: args.presets,
         size: (args.width, args.height),
@@ -272,8 +278,8 @@ pub(crate) fn bench_presets(args: BenchArgs) -> Result<()> {
     };
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
-    let report = quadray::bench::run(&ctx, &config)?;
-    println!("{}", quadray::bench::markdown(&report));
+    let report = quadray::tools::bench::run(&ctx, &config)?;
+    println!("{}", quadray::tools::bench::markdown(&report));
     eprintln!("wrote {}/bench.json, bench.md and bench.png", args.out.display());
     drop(ctx);
     if counters.errors() > 0 {
@@ -295,7 +301,7 @@ pub(crate) fn throughput(args: ThroughputArgs, set_threads: bool) -> Result<()> 
             bail!("baseline binary {} not found", b.display());
         }
     }
-    let config = quadray::throughput::Config {
+    let config = quadray::tools::throughput::Config {
         scenes: args.scenes,
         size: (args.width, args.height),
         spp: args.spp,
@@ -303,14 +309,15 @@ pub(crate) fn throughput(args: ThroughputArgs, set_threads: bool) -> Result<()> 
         binary: quadray::vk::runtime::current_exe().context("cannot find this binary's path")?,
         baseline: args.baseline,
         backends: args.backends,
+        kernels: args.kernels,
         reference_spp: args.reference_spp,
         out_dir: args.out.clone(),
         // Each binary picks its own lavapipe thread count, as it would alone.
         env_remove: if set_threads { vec!["LP_NUM_THREADS".into()] } else { vec![] },
         command,
     };
-    let report = quadray::throughput::run(&config)?;
-    println!("{}", quadray::throughput::markdown(&report));
+    let report = quadray::tools::throughput::run(&config)?;
+    println!("{}", quadray::tools::throughput::markdown(&report));
     eprintln!("wrote {}/throughput.json and throughput.md", args.out.display());
     Ok(())
 }
@@ -340,7 +347,7 @@ pub(crate) struct OutliersArgs {
     /// region (the pixels that see one object, silhouettes left out): a
     /// whole-image error far above the mean of the regions' says that a few
     /// pixels dominate it.
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::model::scene::MAX_SPP))]
     pub(crate) regions: Option<u32>,
     /// Enable the Khronos validation layer; the command fails if it reports errors.
     #[arg(long, env = "QUADRAY_VALIDATION", value_parser = clap::builder::BoolishValueParser::new())]
@@ -429,7 +436,7 @@ pub(crate) fn outliers(args: OutliersArgs) -> Result<()> {
         reference_scene.image.spp = reference_spp;
         let reference = render(&mut cmds, &reference_scene)?;
         let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
-        let e = quadray::metrics::region_relative_mse(&reference, &out, 2, 64)?;
+        let e = quadray::tools::metrics::region_relative_mse(&reference, &out, 2, 64)?;
         println!("\nrelative MSE at {} spp against {reference_spp} spp:", out.spp);
         for (object, pixels, error) in &e.regions {
             let name = names.get(*object as usize).copied().unwrap_or("background");

@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use clap::Parser;
-use quadray::output::{ExrPrecision, OutputKind};
-use quadray::scene::MAX_IMAGE_SIZE;
-use quadray::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
+use quadray::jobs::output::{ExrPrecision, OutputKind};
+use quadray::model::scene::MAX_IMAGE_SIZE;
+use quadray::model::scene::{load_scene, parse_scene, FilterMode, Preset, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 
 /// Image size and seed overrides of `render` and `outliers`.
 #[derive(Parser, Debug, Default, Clone)]
@@ -135,7 +135,7 @@ pub(crate) struct QualityArgs {
     #[arg(long)]
     pub(crate) preset: Option<Preset>,
     /// Samples per pixel (overrides the scene's or preset's `image.spp`).
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::model::scene::MAX_SPP))]
     pub(crate) spp: Option<u32>,
     /// Longest light path in bounces (overrides `image.max_depth`).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=64))]
@@ -175,7 +175,7 @@ pub(crate) struct QualityArgs {
     /// `balanced` or `high` (the default: the best network, 2-6x the time
     /// of `fast`).
     #[arg(long)]
-    pub(crate) denoise_quality: Option<quadray::denoise::DenoiseQuality>,
+    pub(crate) denoise_quality: Option<quadray::jobs::denoise::DenoiseQuality>,
 }
 
 impl QualityArgs {
@@ -203,6 +203,31 @@ pub(crate) fn read_scene(path: Option<&Path>) -> Result<Scene> {
         Some(path) => load_scene(path)?,
         None => parse_scene(DEFAULT_SCENE, DEFAULT_SCENE_NAME)?,
     })
+}
+
+/// `--kernel`: how the render pass runs its paths.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum KernelChoice {
+    /// The faster on this backend (docs/benchmarks.md, "Megakernel and
+    /// wavefront").
+    #[default]
+    Auto,
+    /// One invocation runs a whole path.
+    Megakernel,
+    /// Stage kernels over queues of paths (ray queries only).
+    Wavefront,
+}
+
+impl KernelChoice {
+    /// The render variant's kernel (`None`: auto).
+    pub(crate) fn kernel(self) -> Option<quadray::passes::PathKernel> {
+        use quadray::passes::PathKernel;
+        match self {
+            KernelChoice::Auto => None,
+            KernelChoice::Megakernel => Some(PathKernel::Megakernel),
+            KernelChoice::Wavefront => Some(PathKernel::Wavefront),
+        }
+    }
 }
 
 /// `--backend`: how rays are traced.

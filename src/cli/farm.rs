@@ -1,4 +1,4 @@
-//! `quadray farm`: Slurm job arrays of tiles and frames (`quadray::farm`).
+//! `quadray farm`: Slurm job arrays of tiles and frames (`quadray::jobs::farm`).
 
 use std::path::PathBuf;
 
@@ -7,7 +7,7 @@ use super::images::*;
 use super::render::*;
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use quadray::scene::MAX_IMAGE_SIZE;
+use quadray::model::scene::MAX_IMAGE_SIZE;
 
 /// `quadray farm`: Slurm job arrays of tiles and frames.
 #[derive(Subcommand, Debug)]
@@ -87,7 +87,7 @@ pub(crate) struct FarmSlurmArgs {
 
 /// `quadray farm`.
 pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
-    use quadray::farm::{Farm, Manifest, MANIFEST_VERSION};
+    use quadray::jobs::farm::{Farm, Manifest, MANIFEST_VERSION};
     match cmd {
         FarmCommand::Slurm(args) => {
             let scene =
@@ -95,7 +95,7 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
             let frames = args.frames.map(FrameRange::frames);
             // Flags the farm sets itself would otherwise meet clap's "used
             // more than once" below.
-            quadray::farm::check_render_args(&args.render_args)?;
+            quadray::jobs::farm::check_render_args(&args.render_args)?;
             // The tasks' render command, checked here (flags, scene, tiles)
             // rather than in every task.
             let mut check = vec!["quadray".to_string(), "render".into(), scene.display().to_string()];
@@ -185,8 +185,8 @@ pub(crate) fn farm(cmd: FarmCommand) -> Result<()> {
 }
 
 /// Submits what a farm lacks and says what was submitted.
-pub(crate) fn farm_submit(farm: &mut quadray::farm::Farm, dry_run: bool) -> Result<()> {
-    let nothing = |farm: &quadray::farm::Farm| {
+pub(crate) fn farm_submit(farm: &mut quadray::jobs::farm::Farm, dry_run: bool) -> Result<()> {
+    let nothing = |farm: &quadray::jobs::farm::Farm| {
         eprintln!("farm {}: every tile is rendered and every frame merged; nothing to submit", farm.dir.display())
     };
     if dry_run {
@@ -209,7 +209,7 @@ pub(crate) fn farm_submit(farm: &mut quadray::farm::Farm, dry_run: bool) -> Resu
                     "submitted job array {} ({} task(s): {}) and merge job {} (runs once every task succeeded)",
                     s.array_job,
                     s.tasks.len(),
-                    quadray::farm::array_spec(&s.tasks),
+                    quadray::jobs::farm::array_spec(&s.tasks),
                     s.merge_job
                 );
             }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use super::common::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
-use quadray::output::write_outputs_with;
+use quadray::jobs::output::write_outputs_with;
 
 #[derive(Parser, Debug)]
 pub(crate) struct MergeArgs {
@@ -25,9 +25,12 @@ pub(crate) struct MergeArgs {
 /// `quadray merge`: tiles into the whole frame.
 pub(crate) fn merge(args: MergeArgs) -> Result<()> {
     let outputs = checked_outputs(&args.output)?;
-    let tiles =
-        args.tiles.iter().map(|p| Ok((p.clone(), quadray::output::read_render_exr(p)?))).collect::<Result<Vec<_>>>()?;
-    let (out, metadata) = quadray::merge::merge(&tiles)?;
+    let tiles = args
+        .tiles
+        .iter()
+        .map(|p| Ok((p.clone(), quadray::jobs::output::read_render_exr(p)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let (out, metadata) = quadray::jobs::merge::merge(&tiles)?;
     if tiles.iter().any(|(_, t)| t.output.denoised.is_some()) {
         eprintln!(
             "the tiles' denoised images are left out (each was denoised alone): the merged frame is their raw \
@@ -36,7 +39,7 @@ pub(crate) fn merge(args: MergeArgs) -> Result<()> {
     }
     let exposure = metadata
         .iter()
-        .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
+        .find(|(k, _)| k == quadray::jobs::output::METADATA_EXPOSURE)
         .and_then(|(_, v)| v.parse().ok())
         .unwrap_or(0.0);
     let files = output_files(&outputs, exposure, args.half);
@@ -60,8 +63,8 @@ pub(crate) struct DenoiseArgs {
     #[arg(short, long)]
     pub(crate) output: Option<PathBuf>,
     /// The denoiser's quality: `fast`, `balanced` or `high`.
-    #[arg(long, default_value_t = quadray::denoise::DenoiseQuality::High)]
-    pub(crate) quality: quadray::denoise::DenoiseQuality,
+    #[arg(long, default_value_t = quadray::jobs::denoise::DenoiseQuality::High)]
+    pub(crate) quality: quadray::jobs::denoise::DenoiseQuality,
     /// Write the EXR with 16-bit half floats instead of 32-bit floats.
     #[arg(long)]
     pub(crate) half: bool,
@@ -99,9 +102,10 @@ pub(crate) fn denoise(args: DenoiseArgs) -> Result<()> {
     });
     let outputs = checked_outputs(&out_name)?;
     require_exr(&args.input)?;
-    let mut denoiser = quadray::denoise::Denoiser::load()?;
-    let quadray::output::ExrFile { mut output, mut metadata } = quadray::output::read_render_exr(&args.input)
-        .with_context(|| format!("cannot read {} as a render", args.input.display()))?;
+    let mut denoiser = quadray::jobs::denoise::Denoiser::load()?;
+    let quadray::jobs::output::ExrFile { mut output, mut metadata } =
+        quadray::jobs::output::read_render_exr(&args.input)
+            .with_context(|| format!("cannot read {} as a render", args.input.display()))?;
     if output.aov.is_empty() || output.aov.iter().all(|a| a.denoise_albedo == [0.0; 3]) {
         eprintln!(
             "{} has no denoiser features (denoise_albedo, denoise_normal): denoising the colour alone",
@@ -112,11 +116,11 @@ pub(crate) fn denoise(args: DenoiseArgs) -> Result<()> {
     let (done, seconds) = super::render::denoise_into(&mut denoiser, &mut output, args.quality)?;
     let exposure = metadata
         .iter()
-        .find(|(k, _)| k == quadray::output::METADATA_EXPOSURE)
+        .find(|(k, _)| k == quadray::jobs::output::METADATA_EXPOSURE)
         .and_then(|(_, v)| v.parse().ok())
         .unwrap_or(0.0);
-    metadata.retain(|(k, _)| k != quadray::output::METADATA_DENOISED);
-    metadata.push((quadray::output::METADATA_DENOISED.to_string(), done.clone()));
+    metadata.retain(|(k, _)| k != quadray::jobs::output::METADATA_DENOISED);
+    metadata.push((quadray::jobs::output::METADATA_DENOISED.to_string(), done.clone()));
     let files = output_files(&outputs, exposure, args.half);
     write_outputs_with(&output, &files, &metadata)?;
     let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
@@ -139,7 +143,7 @@ pub(crate) struct CompareArgs {
 pub(crate) fn compare(args: CompareArgs) -> Result<()> {
     let read = |path: &Path| -> Result<quadray::passes::RenderOutput> {
         let (width, height, texels) =
-            quadray::texture::read_exr_image(path).with_context(|| format!("cannot read {}", path.display()))?;
+            quadray::model::texture::read_exr_image(path).with_context(|| format!("cannot read {}", path.display()))?;
         Ok(quadray::passes::RenderOutput::from_radiance(
             width,
             height,
@@ -159,8 +163,8 @@ pub(crate) fn compare(args: CompareArgs) -> Result<()> {
             test.height
         );
     }
-    let flip = quadray::metrics::flip_mean(&reference, &test, args.exposure)?;
-    let rel_mse = quadray::metrics::relative_mse(&reference, &test)?;
+    let flip = quadray::tools::metrics::flip_mean(&reference, &test, args.exposure)?;
+    let rel_mse = quadray::tools::metrics::relative_mse(&reference, &test)?;
     let lum = |p: &[f32; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
     let (worst, _) =
         reference.radiance.iter().zip(&test.radiance).enumerate().fold((0, -1.0f32), |best, (i, (r, t))| {

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use super::common::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
-use quadray::output::write_outputs_with;
+use quadray::jobs::output::write_outputs_with;
+use quadray::model::scene::{Scene, DEFAULT_SCENE_NAME};
 use quadray::passes::{IntersectMode, SamplerMode, ShadingMode};
-use quadray::progress::ProgressBar;
-use quadray::scene::{Scene, DEFAULT_SCENE_NAME};
+use quadray::util::progress::ProgressBar;
 
 #[derive(Parser, Debug, Default)]
 pub(crate) struct RenderArgs {
@@ -51,6 +51,12 @@ pub(crate) struct RenderArgs {
     /// and volume passes alike). The images agree to float rounding.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto, env = "QUADRAY_BACKEND")]
     pub(crate) backend: BackendChoice,
+    /// How the render pass runs its paths: `auto`, `megakernel` (one
+    /// invocation a whole path) or `wavefront` (stage kernels over queues of
+    /// paths: camera rays, tracing, shading; ray queries only). The images
+    /// agree to float rounding.
+    #[arg(long, value_enum, default_value_t = KernelChoice::Auto, env = "QUADRAY_KERNEL")]
+    pub(crate) kernel: KernelChoice,
     /// The path tracer's samples: `sobol` (Owen-scrambled Sobol points, one
     /// dimension pair per decision along the path; lower error at equal
     /// spp) or `independent` (independent random numbers, whose per-pixel
@@ -149,7 +155,7 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
         );
     }
     // A missing denoiser is an error before any work, with nothing written.
-    let mut denoiser = if scene.image.denoise { Some(quadray::denoise::Denoiser::load()?) } else { None };
+    let mut denoiser = if scene.image.denoise { Some(quadray::jobs::denoise::Denoiser::load()?) } else { None };
     let ctx = quadray::vk::Context::new(args.validation).context("cannot start Vulkan")?;
     let counters = ctx.counters();
     let backend = args.backend.resolve(&ctx.device)?;
@@ -158,12 +164,13 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
         volume: !args.brute_force,
         sampler: args.sampler,
         backend: Some(backend),
+        kernel: args.kernel.kernel(),
         ..Default::default()
     };
     let mut interrupted = false;
     if args.bench {
         let mut out = bench(&ctx, &scene, backend)?;
-        let end = quadray::job::JobEnd::Complete;
+        let end = quadray::jobs::job::JobEnd::Complete;
         write_render(&args, &ctx, &scene, variant, &outputs, None, &mut out, end, denoiser.as_mut())?;
     } else {
         let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -172,7 +179,7 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
             signal_hook::flag::register_conditional_shutdown(signal, 1, stop.clone())?;
             signal_hook::flag::register(signal, stop.clone())?;
         }
-        let options = quadray::job::JobOptions {
+        let options = quadray::jobs::job::JobOptions {
             bounds,
             checkpoint: args.checkpoint.clone().or_else(|| args.resume.clone()),
             checkpoint_every: std::time::Duration::from_secs_f64(args.checkpoint_every),
@@ -186,10 +193,10 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
         let list: Vec<Option<u32>> = frames.map_or(vec![None], |f| f.into_iter().map(Some).collect());
         let first = list[0].map_or_else(|| scene.clone(), |f| scene.at_frame(f));
         // A wrong checkpoint is refused before any GPU work.
-        let mut resume = quadray::job::read_resume(&first, variant, &options)?;
+        let mut resume = quadray::jobs::job::read_resume(&first, variant, &options)?;
         // The shaders compile from here to the first dispatch's end.
         let mut first_progress = Some(ProgressBar::new(args.progress).compiling());
-        let mut job = quadray::job::Job::new(&ctx, &first, variant, bounds).context("render failed")?;
+        let mut job = quadray::jobs::job::Job::new(&ctx, &first, variant, bounds).context("render failed")?;
         for frame in list {
             let frame_scene = frame.map_or_else(|| scene.clone(), |f| scene.at_frame(f));
             let mut progress = first_progress.take().unwrap_or_else(|| ProgressBar::new(args.progress));
@@ -200,13 +207,13 @@ pub(crate) fn render(args: RenderArgs) -> Result<()> {
                 eprintln!("resumed at {} of {} spp", result.resumed_from, frame_scene.image.spp);
             }
             let paths: Vec<PathBuf> = match frame {
-                Some(f) => outputs.iter().map(|p| quadray::output::frame_path(p, f)).collect(),
+                Some(f) => outputs.iter().map(|p| quadray::jobs::output::frame_path(p, f)).collect(),
                 None => outputs.clone(),
             };
             let mut out = result.output;
             write_render(&args, &ctx, &frame_scene, variant, &paths, frame, &mut out, result.end, denoiser.as_mut())?;
-            if result.end != quadray::job::JobEnd::Complete {
-                interrupted = result.end == quadray::job::JobEnd::Interrupted;
+            if result.end != quadray::jobs::job::JobEnd::Complete {
+                interrupted = result.end == quadray::jobs::job::JobEnd::Interrupted;
                 break;
             }
         }
@@ -233,8 +240,8 @@ pub(crate) fn write_render(
     outputs: &[PathBuf],
     frame: Option<u32>,
     out: &mut quadray::passes::RenderOutput,
-    end: quadray::job::JobEnd,
-    denoiser: Option<&mut quadray::denoise::Denoiser>,
+    end: quadray::jobs::job::JobEnd,
+    denoiser: Option<&mut quadray::jobs::denoise::Denoiser>,
 ) -> Result<()> {
     if ctx.counters().errors() > 0 {
         bail!("the validation layer reported {} error(s); no output written", ctx.counters().errors());
@@ -244,39 +251,39 @@ pub(crate) fn write_render(
         None => None,
     };
     let files = output_files(outputs, scene.image.exposure, args.half);
-    let key = quadray::job::image_key(scene, variant);
+    let key = quadray::jobs::job::image_key(scene, variant);
     let mut metadata: Vec<(String, String)> = [
-        (quadray::output::METADATA_SPP, out.spp.to_string()),
-        (quadray::output::METADATA_TARGET_SPP, scene.image.spp.to_string()),
-        (quadray::output::METADATA_SEED, scene.image.seed.to_string()),
-        (quadray::output::METADATA_EXPOSURE, scene.image.exposure.to_string()),
-        (quadray::output::METADATA_SCENE_KEY, format!("{key:016x}")),
+        (quadray::jobs::output::METADATA_SPP, out.spp.to_string()),
+        (quadray::jobs::output::METADATA_TARGET_SPP, scene.image.spp.to_string()),
+        (quadray::jobs::output::METADATA_SEED, scene.image.seed.to_string()),
+        (quadray::jobs::output::METADATA_EXPOSURE, scene.image.exposure.to_string()),
+        (quadray::jobs::output::METADATA_SCENE_KEY, format!("{key:016x}")),
     ]
     .map(|(k, v)| (k.to_string(), v))
     .to_vec();
     if let Some(f) = frame {
-        metadata.push((quadray::output::METADATA_FRAME.to_string(), f.to_string()));
+        metadata.push((quadray::jobs::output::METADATA_FRAME.to_string(), f.to_string()));
     }
     if let Some(b) = out.backend {
-        metadata.push((quadray::output::METADATA_BACKEND.to_string(), b.to_string()));
+        metadata.push((quadray::jobs::output::METADATA_BACKEND.to_string(), b.to_string()));
     }
-    metadata.push((quadray::output::METADATA_DEVICE.to_string(), ctx.device.name.clone()));
-    metadata.push((quadray::output::METADATA_DRIVER.to_string(), ctx.device.driver.clone()));
+    metadata.push((quadray::jobs::output::METADATA_DEVICE.to_string(), ctx.device.name.clone()));
+    metadata.push((quadray::jobs::output::METADATA_DRIVER.to_string(), ctx.device.driver.clone()));
     if let Some((d, _)) = &denoised {
-        metadata.push((quadray::output::METADATA_DENOISED.to_string(), d.clone()));
+        metadata.push((quadray::jobs::output::METADATA_DENOISED.to_string(), d.clone()));
     }
     write_outputs_with(out, &files, &metadata)?;
     let checkpoint = args.checkpoint.as_ref().or(args.resume.as_ref());
     match (end, checkpoint) {
-        (quadray::job::JobEnd::Complete, Some(path)) if path.exists() => {
+        (quadray::jobs::job::JobEnd::Complete, Some(path)) if path.exists() => {
             // The images are the render now; a checkpoint left behind would
             // only be resumed into the same images.
             std::fs::remove_file(path).with_context(|| format!("cannot remove {}", path.display()))?;
         }
-        (quadray::job::JobEnd::Complete, _) => {}
+        (quadray::jobs::job::JobEnd::Complete, _) => {}
         (stopped, path) => eprintln!(
             "{}: wrote the image so far ({} spp of {}{}){}",
-            if stopped == quadray::job::JobEnd::Interrupted { "interrupted" } else { "time limit reached" },
+            if stopped == quadray::jobs::job::JobEnd::Interrupted { "interrupted" } else { "time limit reached" },
             out.spp,
             scene.image.spp,
             if out.partial_tiles > 0 {
@@ -338,13 +345,13 @@ pub(crate) fn write_render(
 /// render denoised twice, or resumed, writes the same bytes) and the
 /// seconds it took.
 pub(crate) fn denoise_into(
-    denoiser: &mut quadray::denoise::Denoiser,
+    denoiser: &mut quadray::jobs::denoise::Denoiser,
     out: &mut quadray::passes::RenderOutput,
-    quality: quadray::denoise::DenoiseQuality,
+    quality: quadray::jobs::denoise::DenoiseQuality,
 ) -> Result<(String, f64)> {
     let start = std::time::Instant::now();
-    let features = quadray::denoise::has_features(out);
-    out.denoised = Some(quadray::denoise::denoise_output(denoiser, out, quality)?);
+    let features = quadray::jobs::denoise::has_features(out);
+    out.denoised = Some(quadray::jobs::denoise::denoise_output(denoiser, out, quality)?);
     let v = denoiser.version;
     let what = format!(
         "Intel Open Image Denoise {}.{}.{}, {quality} quality, {}",
@@ -446,9 +453,54 @@ pub(crate) fn bench(
     }
     let line: Vec<String> = by_backend.iter().map(|(b, rate)| format!("{b} {rate:.0}")).collect();
     eprintln!("full render, samples/s by backend: {}", line.join(", "));
+    if device.offers(Backend::RayQuery) {
+        print_kernels(ctx, &mut cmds, &gpu, scene, variants[0].1)?;
+    }
     let full = full.expect("the full render");
     print_frame_table(&full, rows[2].1, im.spp);
     Ok(full)
+}
+
+/// The full render with each kernel (ray queries), side by side, and where
+/// the wavefront pass's time goes stage by stage.
+fn print_kernels(
+    ctx: &quadray::vk::Context,
+    cmds: &mut quadray::vk::Commands,
+    gpu: &quadray::passes::GpuScene,
+    scene: &Scene,
+    full: quadray::passes::RenderVariant,
+) -> Result<()> {
+    use quadray::passes::{render, PathKernel, RenderVariant, Renderer};
+    let samples = scene.image.width as f64 * scene.image.height as f64 * scene.image.spp as f64;
+    let mut rates = Vec::new();
+    let mut profile = None;
+    for kernel in PathKernel::ALL {
+        let variant = RenderVariant { kernel: Some(kernel), backend: Some(quadray::vk::Backend::RayQuery), ..full };
+        Renderer::warm_up(&ctx.device, cmds, gpu, scene, variant)?;
+        let out = render(&ctx.device, cmds, gpu, scene, variant, &mut |_, _| {})?;
+        rates.push(format!("{kernel} {:.0}", samples / out.render_seconds));
+        profile = profile.or(out.wave_profile);
+    }
+    eprintln!("render pass, samples/s by kernel (ray queries): {}", rates.join(", "));
+    if let Some(p) = profile {
+        let total = p.start + p.trace + p.shade + p.other;
+        let share = |s: f64| 100.0 * s / total;
+        eprintln!(
+            "wavefront stages: camera rays {:.3} s ({:.0}%), trace {:.3} s ({:.0}%), shade {:.3} s ({:.0}%), \
+             between stages {:.3} s ({:.0}%); {} iterations in {} waves",
+            p.start,
+            share(p.start),
+            p.trace,
+            share(p.trace),
+            p.shade,
+            share(p.shade),
+            p.other,
+            share(p.other),
+            p.iterations,
+            p.waves
+        );
+    }
+    Ok(())
 }
 
 /// Per-pass times of one frame in the layout of the paper's table 1: a

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use super::common::*;
 use anyhow::{bail, Context as _, Result};
 use clap::Parser;
-use quadray::scene::Preset;
-use quadray::scene::MAX_IMAGE_SIZE;
+use quadray::model::scene::Preset;
+use quadray::model::scene::MAX_IMAGE_SIZE;
 
 #[cfg(feature = "viewer")]
 #[derive(Parser, Debug)]
@@ -29,7 +29,7 @@ pub(crate) struct ViewArgs {
     pub(crate) height: Option<u32>,
     /// Samples per pixel to accumulate before the view stops refining
     /// (default: the preset's or scene's spp).
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::scene::MAX_SPP))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=quadray::model::scene::MAX_SPP))]
     pub(crate) max_spp: Option<u32>,
     /// Start with the caustic and volume passes off (brute force).
     #[arg(long)]

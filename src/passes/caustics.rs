@@ -24,49 +24,23 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
+pub use super::film::CausticReport;
 use super::gpu::{CausticPush, GpuCausticRay, GpuEmitter, GpuReceiver};
 use super::scene_gpu::GpuScene;
 use super::tracer::Tracer;
 use super::IntersectMode;
-use crate::geometry::CellParams;
-use crate::scene::{Light, Scene};
-use crate::shader_interface::{
+use super::RenderError;
+use crate::gpu::shader_interface::{
     BEAM_STRIDE, BINDING_CAUSTIC_BEAMS, BINDING_CAUSTIC_MAP, BINDING_CAUSTIC_RAYS, BINDING_GBUFFER,
     CAUSTIC_FIXED_POINT, CAUSTIC_GROUP, EMITTER_PARALLEL, EMITTER_POINT, RENDER_GROUP, SPEC_INTERSECT_MODE,
     SPEC_MEDIA_ENABLED,
 };
+use crate::gpu::shaders;
+use crate::model::geometry::CellParams;
+use crate::model::scene::{Light, Scene};
 use crate::vk::{
     Access, Backend, Binding, Buffer, Commands, ComputePipeline, Device, GpuTimer, MemoryLocation, ShaderStage,
 };
-use crate::{shaders, RenderError};
-
-/// What the caustic passes did, and how long they took.
-#[derive(Clone, Debug, Default)]
-pub struct CausticReport {
-    /// Caustic rays traced (all grids).
-    pub rays: u64,
-    /// Rays that landed on a diffuse receiver after a specular vertex.
-    pub landed: u64,
-    /// Emission grids (lights × light samples).
-    pub grids: usize,
-    /// GPU time of the G-buffer pass (s).
-    pub gbuffer_seconds: f64,
-    /// GPU time of the caustic-ray pass (s).
-    pub trace_seconds: f64,
-    /// GPU time of the caustic-cell splat pass (s).
-    pub splat_seconds: f64,
-    /// GPU time of the volumetric-caustic (beam) pass (s); 0 without fog.
-    pub beam_seconds: f64,
-    /// Caustic irradiance per pixel (W/m², RGB) at the pixel-centre receiver.
-    pub irradiance: Vec<[f32; 3]>,
-}
-
-impl CausticReport {
-    /// Total GPU time of the caustic passes (s).
-    pub fn seconds(&self) -> f64 {
-        self.gbuffer_seconds + self.trace_seconds + self.splat_seconds + self.beam_seconds
-    }
-}
 
 /// The caustic passes: their pipelines, the rays, and the results that the
 /// render pass binds. [`CausticMap::new`] builds them for one image size and
@@ -232,6 +206,17 @@ fn parallel_grid(w: DVec3, irradiance: DVec3, corners: &[DVec3], centre: DVec3, 
 }
 
 impl CausticMap {
+    /// What the render pass reads from the caustic passes: the receivers,
+    /// the caustic map and the beam map, or `placeholder` at each binding
+    /// where the passes did not run (`map` is `None`).
+    pub fn render_bindings<'a>(map: Option<&'a CausticMap>, placeholder: &'a Buffer) -> [(u32, Binding<'a>); 3] {
+        [
+            (BINDING_GBUFFER, Binding::Buffer(map.map_or(placeholder, |c| &c.receivers))),
+            (BINDING_CAUSTIC_MAP, Binding::Buffer(map.map_or(placeholder, |c| &c.map))),
+            (BINDING_CAUSTIC_BEAMS, Binding::Buffer(map.map_or(placeholder, |c| &c.beams))),
+        ]
+    }
+
     /// Creates the pipelines and buffers for a `width` x `height` image whose
     /// frame parameters are in `frame`; nothing runs yet. The G-buffer and
     /// the caustic rays trace with `backend`.

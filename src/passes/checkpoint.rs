@@ -20,12 +20,11 @@
 //! pixel over the bounds; then FNV-1a of everything before it (u64), so that
 //! a truncated or damaged file is refused rather than resumed.
 
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 use super::film::{Accumulation, PixelBounds};
 use super::gpu::GpuAov;
-use crate::hash::Fnv1a;
+use crate::util::hash::Fnv1a;
 
 const MAGIC: &[u8; 8] = b"QRAYCKP2";
 
@@ -77,14 +76,25 @@ pub enum CheckpointError {
     },
 }
 
+/// The version of the key's serialisation: bumped when a change to the
+/// scene model or the variant changes the image an unchanged scene file
+/// makes (old checkpoints must then not resume), never by a change that
+/// leaves the image alone.
+pub const KEY_VERSION: u32 = 1;
+
 /// A hash of everything that makes a render's image: the scene (objects,
 /// materials, lights, camera, image and quality settings, the seed) and
 /// `settings` (the caller's other switches, e.g. the render variant),
-/// through their `Debug` forms, streamed.
-pub fn render_key(scene: &impl fmt::Debug, settings: &impl fmt::Debug) -> u64 {
-    use std::fmt::Write as _;
+/// through a stable serialisation (serde's JSON of their fields, in
+/// declaration order; no `Debug` form, no hash-map order), after the key
+/// version, streamed (FNV-1a).
+pub fn render_key(scene: &impl serde::Serialize, settings: &impl serde::Serialize) -> u64 {
+    use std::io::Write as _;
     let mut h = Fnv1a::default();
-    write!(h, "{scene:?}\u{0}{settings:?}").expect("hashing cannot fail");
+    write!(h, "quadray render key v{KEY_VERSION}\u{0}").expect("hashing cannot fail");
+    serde_json::to_writer(&mut h, scene).expect("the scene serialises");
+    h.write_all(&[0]).expect("hashing cannot fail");
+    serde_json::to_writer(&mut h, settings).expect("the settings serialise");
     h.finish()
 }
 
@@ -176,7 +186,7 @@ impl Checkpoint {
     /// place): a render killed while writing leaves the previous one.
     pub fn write(&self, path: &Path) -> Result<(), CheckpointError> {
         let bytes = self.to_bytes();
-        crate::files::write_file_atomically(path, &bytes)
+        crate::util::files::write_file_atomically(path, &bytes)
             .map_err(|source| CheckpointError::Io { path: path.into(), source })
     }
 

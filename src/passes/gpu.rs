@@ -8,12 +8,12 @@ use bytemuck::{Pod, Zeroable};
 
 use glam::{DAffine3, DVec3};
 
-use crate::geometry::{Perturbation, Quadric};
-use crate::scene::{ConductorFresnel, Light, Material, MaterialKind, SceneObject, UvMapping};
-use crate::shader_interface::{
+use crate::gpu::shader_interface::{
     FRESNEL_COMPLEX, FRESNEL_SCHLICK, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_RECT, LIGHT_SPHERE, MATERIAL_CONDUCTOR,
     MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_MIRROR, NO_TEXTURE, UV_CYLINDRICAL, UV_PLANAR, UV_SPHERICAL,
 };
+use crate::model::geometry::{Perturbation, Quadric};
+use crate::model::scene::{ConductorFresnel, Light, Material, MaterialKind, SceneObject, UvMapping};
 
 include!(concat!(env!("OUT_DIR"), "/gpu_structs.rs"));
 
@@ -29,7 +29,7 @@ impl From<&Quadric> for GpuQuadric {
 }
 
 /// Object-frame distance (in object units, and in sizes of the object's box)
-/// beyond which rays are re-based (`glsl/root_search.glsl`): there an f32
+/// beyond which rays are re-based (`glsl/intersection/root_search.glsl`): there an f32
 /// ray parameter resolves 6e-8 · 64 = 4e-6 of the distance.
 pub const REBASE_DISTANCE: f64 = 64.0;
 
@@ -97,8 +97,8 @@ impl From<&Perturbation> for GpuPerturbation {
     }
 }
 
-impl From<Option<&crate::scene::Medium>> for GpuMedium {
-    fn from(m: Option<&crate::scene::Medium>) -> Self {
+impl From<Option<&crate::model::scene::Medium>> for GpuMedium {
+    fn from(m: Option<&crate::model::scene::Medium>) -> Self {
         m.map_or_else(Self::default, |m| Self {
             density: m.density,
             albedo: m.albedo.to_array(),

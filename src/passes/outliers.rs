@@ -32,7 +32,7 @@
 //! scattering events in a medium sample their directions from a mixture of
 //! the phase function and a light's halo, whose weight phase / mixture can
 //! exceed 1; their share of the halo
-//! ([`crate::sampling::phase::halo_share`]) keeps the throughput at most 2,
+//! ([`crate::model::sampling::phase::halo_share`]) keeps the throughput at most 2,
 //! so the bound of a scene with media is multiplied by 2.
 //!
 //! The bound needs area emitters: point and directional lights have no
@@ -44,11 +44,11 @@
 use std::fmt::Write as _;
 
 use super::{RecordedPath, RenderOutput};
-use crate::scene::{Light, Scene};
-use crate::shader_interface::{
+use crate::gpu::shader_interface::{
     EVENT_EMITTER, EVENT_END, EVENT_LIGHT_SAMPLE, EVENT_MEDIUM, EVENT_PASS_THROUGH, EVENT_ROULETTE, EVENT_SHADOW,
     EVENT_SURFACE, LOBE_INVALID, LOBE_REFLECT, LOBE_TRANSMIT, NO_HIT, NO_TEXTURE,
 };
+use crate::model::scene::{Light, Scene};
 
 /// Rec. 709 luminance of linear RGB (the weights pixel.glsl uses).
 pub fn luminance(c: [f32; 3]) -> f32 {

@@ -7,13 +7,14 @@ use super::gpu::{GpuHit, GpuRay, ProbePush};
 use super::scene_gpu::GpuScene;
 use super::tracer::Tracer;
 use super::IntersectMode;
-use crate::shader_interface::{
+use super::RenderError;
+use crate::gpu::shader_interface::{
     BINDING_PROBE_HITS, BINDING_PROBE_RAYS, PROBE_GROUP, SPEC_INTERSECT_MODE, SPEC_PROBE_CURVATURE,
 };
+use crate::gpu::shaders;
 use crate::vk::{
     vk, Access, Backend, Binding, Buffer, Commands, Device, MemoryLocation, Recording, ShaderStage, Timestamps,
 };
-use crate::{shaders, RenderError};
 
 /// Rays per dispatch: short enough never to trip a driver watchdog.
 const RAYS_PER_DISPATCH: u32 = 1 << 16;

@@ -1,29 +1,86 @@
-//! The render pass: for every sample and every tile, one dispatch that
-//! traces a path from every pixel of the tile (glsl/render.comp, the path
-//! tracer of glsl/render.glsl). Tiles keep each submission short; progress
-//! is reported after each.
+//! The render pass: for every sample and every tile, a path from every
+//! pixel of the tile (the path tracer of glsl/render/render.glsl), run by one
+//! dispatch of the megakernel (glsl/render/render.comp, render.rgen) or by the
+//! wavefront pass's stage kernels ([`super::wavefront`]). Tiles keep each
+//! submission short; progress is reported after each.
 
 use std::sync::Arc;
 
 use super::caustics::{emitters, CausticMap, CausticReport};
+use super::config::RenderConfig;
 use super::film::{Accumulation, PixelBounds, RenderOutput};
 use super::gpu::{GpuAov, GpuCausticRay, GpuEmitter, GpuFrame, GpuMedium, GpuPathRecord, GpuPathVertex, RenderPush};
 use super::scene_gpu::{camera_basis, GpuScene};
 use super::tracer::Tracer;
 use super::volume::VolumeLight;
-use super::{RenderVariant, ShadingMode};
-use crate::scene::Scene;
-use crate::shader_interface::{
-    BINDING_ACCUM, BINDING_AOV, BINDING_CAUSTIC_BEAMS, BINDING_CAUSTIC_MAP, BINDING_ENV_CDF, BINDING_GBUFFER,
-    BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, BINDING_VOLUME, NO_TEXTURE, PATH_RECORD_VERTICES, RENDER_GROUP,
-    SPEC_BEAMS_ENABLED, SPEC_CAUSTICS_ENABLED, SPEC_FILTER_MODE, SPEC_INTERSECT_MODE, SPEC_LOOKUP_MODE,
-    SPEC_MEDIA_ENABLED, SPEC_RECORD_PATH, SPEC_SAMPLER, SPEC_SHADING_MODE, SPEC_VOLUME_ENABLED,
+use super::wavefront::{WaveProfile, Wavefront};
+use super::RenderError;
+use super::{PathKernel, RenderVariant, ShadingMode};
+use crate::gpu::shader_interface::{
+    BINDING_ACCUM, BINDING_AOV, BINDING_ENV_CDF, BINDING_RENDER_MAX_SAMPLE, BINDING_RENDER_PATH, NO_TEXTURE,
+    PATH_RECORD_VERTICES, RENDER_GROUP, RENDER_TILE,
 };
-use crate::vk::{vk, Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation, ShaderStage};
-use crate::{shaders, RenderError};
+use crate::gpu::shaders;
+use crate::model::scene::Scene;
+use crate::vk::{
+    vk, Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, Image, MemoryLocation, ShaderStage, VkError,
+};
 
 /// Pixels per tile side: a tile is one dispatch of one sample.
-const TILE: u32 = 256;
+const TILE: u32 = RENDER_TILE;
+
+/// The render pass's paths, run by one of two kernels ([`PathKernel`]).
+enum PathPass {
+    /// One invocation a path, on either backend.
+    Megakernel(Box<Tracer>),
+    /// Stage kernels over queues (ray queries).
+    Wavefront(Box<Wavefront>),
+}
+
+impl PathPass {
+    /// The backend that traces.
+    fn backend(&self) -> Backend {
+        match self {
+            PathPass::Megakernel(t) => t.backend(),
+            PathPass::Wavefront(_) => Backend::RayQuery,
+        }
+    }
+
+    /// The shader stage whose accesses the pass's barriers name.
+    fn stage(&self) -> ShaderStage {
+        self.backend().into()
+    }
+
+    fn bind(&self, resources: &[(u32, Binding<'_>)]) -> Result<(), VkError> {
+        match self {
+            PathPass::Megakernel(t) => t.bind(resources),
+            PathPass::Wavefront(w) => w.bind(resources),
+        }
+    }
+
+    /// Adds one sample of the tile `push` names, after `before` (with
+    /// `access`, the pass's own); returns its GPU time in seconds.
+    fn run_tile(
+        &self,
+        cmds: &mut Commands,
+        timer: &GpuTimer,
+        push: RenderPush,
+        (before, access): (&[Access], &[Access]),
+    ) -> Result<f64, VkError> {
+        match self {
+            PathPass::Megakernel(t) => {
+                let size = push.tile_size;
+                let group = if size == [1, 1] { [1, 1] } else { [RENDER_GROUP, RENDER_GROUP] };
+                let ((), seconds) = timer.run(cmds, |rec| {
+                    rec.barrier(before, access);
+                    t.run(rec.cmd, bytemuck::bytes_of(&push), size, group)
+                })?;
+                Ok(seconds)
+            }
+            PathPass::Wavefront(w) => w.render_tile(cmds, timer, push, before),
+        }
+    }
+}
 
 /// The events of one recorded path ([`Renderer::trace_path`]).
 #[derive(Clone, Debug, Default)]
@@ -64,7 +121,7 @@ pub const PIXEL_FILTER_SIGMA: f32 = 0.5;
 /// How far from its pixel's centre a camera ray can land, in pixels: the
 /// jitter is a Box-Muller Gaussian of σ = [`PIXEL_FILTER_SIGMA`] driven by
 /// 24-bit uniform numbers, so its radius is at most σ·√(−2 ln 2⁻²⁴)
-/// = 2.884 px (`gaussianPixelOffset` in glsl/frame.glsl). Tests that skip
+/// = 2.884 px (`gaussianPixelOffset` in glsl/intersection/frame.glsl). Tests that skip
 /// pixels near an edge skip this far.
 pub const PIXEL_FILTER_REACH: f32 = PIXEL_FILTER_SIGMA * 5.768_108;
 
@@ -125,7 +182,7 @@ fn gpu_frame(scene: &Scene, gpu: &GpuScene, width: u32, height: u32, spp: u32) -
 /// same estimate however it is split.
 pub struct Renderer {
     // Pipelines first: dropped before the buffers their descriptors name.
-    pipeline: Tracer,
+    pipeline: PathPass,
     device: Arc<Device>,
     caustics: Option<CausticMap>,
     volume: Option<VolumeLight>,
@@ -272,23 +329,19 @@ impl Renderer {
         let path = Buffer::storage(device, "recorded path", path_bytes, MemoryLocation::GpuToCpu)?;
         let pipeline = render_pipeline(device, gpu, scene, (variant, backend), caustics.as_ref(), volume.is_some())?;
         {
-            let receivers = caustics.as_ref().map_or(&placeholder, |c| &c.receivers);
-            let caustic_map = caustics.as_ref().map_or(&placeholder, |c| &c.map);
-            let beam_map = caustics.as_ref().map_or(&placeholder, |c| &c.beams);
-            let volume_radiance = volume.as_ref().map_or(&placeholder, |v| &v.radiance);
             let mut bindings = gpu.frame_bindings(&frame);
             bindings.extend([
                 (BINDING_ACCUM, Binding::Image(&accum)),
                 (BINDING_AOV, Binding::Buffer(&aov)),
                 gpu.texture_binding(),
                 (BINDING_ENV_CDF, Binding::Buffer(&gpu.env_cdf)),
-                (BINDING_GBUFFER, Binding::Buffer(receivers)),
-                (BINDING_CAUSTIC_MAP, Binding::Buffer(caustic_map)),
-                (BINDING_VOLUME, Binding::Buffer(volume_radiance)),
-                (BINDING_CAUSTIC_BEAMS, Binding::Buffer(beam_map)),
                 (BINDING_RENDER_MAX_SAMPLE, Binding::Image(&max_sample)),
                 (BINDING_RENDER_PATH, Binding::Buffer(&path)),
             ]);
+            // What the passes that ran before made (placeholders for those
+            // that did not).
+            bindings.extend(CausticMap::render_bindings(caustics.as_ref(), &placeholder));
+            bindings.extend(VolumeLight::render_bindings(volume.as_ref(), &placeholder));
             pipeline.bind(&bindings)?;
         }
         // Cleared next (restart), then written by the samples.
@@ -389,6 +442,15 @@ impl Renderer {
             + self.volume_seconds().unwrap_or(0.0)
     }
 
+    /// Where the wavefront pass's GPU time went, stage by stage (none with
+    /// the megakernel).
+    pub fn wave_profile(&self) -> Option<WaveProfile> {
+        match &self.pipeline {
+            PathPass::Wavefront(w) => Some(w.profile()),
+            PathPass::Megakernel(_) => None,
+        }
+    }
+
     /// GPU time of the volume pass's last run (s), when the pass runs.
     pub fn volume_seconds(&self) -> Option<f64> {
         self.volume.as_ref().map(|v| v.seconds)
@@ -426,13 +488,10 @@ impl Renderer {
                 tile_size: [t[2], t[3]],
                 sample_index: self.samples,
                 write_aov: (self.samples == 0) as u32,
+                wave: 0,
             };
-            let pipeline = &self.pipeline;
             let (before, sample) = self.sample_dependency();
-            let ((), seconds) = self.timer.run(cmds, |rec| {
-                rec.barrier(&before, &sample);
-                pipeline.run(rec.cmd, bytemuck::bytes_of(&push), [t[2], t[3]], [RENDER_GROUP, RENDER_GROUP])
-            })?;
+            let seconds = self.pipeline.run_tile(cmds, &self.timer, push, (&before, &sample))?;
             self.render_seconds += seconds;
             self.tiles_done += 1;
             if self.tiles_done == self.tiles.len() {
@@ -611,6 +670,7 @@ impl Renderer {
             volume_seconds: self.volume_seconds(),
             seconds: self.seconds(),
             backend: Some(self.pipeline.backend()),
+            wave_profile: self.wave_profile(),
             ..acc.into_output(&self.sample_counts())
         })
     }
@@ -628,13 +688,9 @@ impl Renderer {
     ) -> Result<RecordedPath, RenderError> {
         assert!(x < self.size.0 && y < self.size.1, "pixel ({x}, {y}) outside the image");
         self.path.write(0, &[0u8; 4]);
-        let push = RenderPush { tile_origin: [x, y], tile_size: [1, 1], sample_index: sample, write_aov: 0 };
-        let pipeline = &self.pipeline;
+        let push = RenderPush { tile_origin: [x, y], tile_size: [1, 1], sample_index: sample, write_aov: 0, wave: 0 };
         let (before, sample) = self.sample_dependency();
-        cmds.run(|rec| {
-            rec.barrier(&before, &sample);
-            pipeline.run(rec.cmd, bytemuck::bytes_of(&push), [1, 1], [1, 1]);
-        })?;
+        self.pipeline.run_tile(cmds, &self.timer, push, (&before, &sample))?;
         let bytes: Vec<u8> = self.path.read();
         let total = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
         let kept = total.min(PATH_RECORD_VERTICES) as usize;
@@ -645,7 +701,8 @@ impl Renderer {
     }
 }
 
-/// The render shader specialised for `variant` and the passes that run.
+/// The render pass's kernels specialised for `variant` and the passes that
+/// run.
 fn render_pipeline(
     device: &Arc<Device>,
     gpu: &GpuScene,
@@ -653,28 +710,21 @@ fn render_pipeline(
     (variant, backend): (RenderVariant, Backend),
     caustics: Option<&CausticMap>,
     volume: bool,
-) -> Result<Tracer, RenderError> {
-    let [budget, far] = gpu.scene_constants();
-    Ok(Tracer::new(
-        device,
-        backend,
-        shaders::render,
-        shaders::render_rgen,
-        &[
-            (SPEC_INTERSECT_MODE, gpu.intersect_mode(variant.intersect).constant()),
-            budget,
-            far,
-            (SPEC_SHADING_MODE, variant.shading.constant()),
-            (SPEC_FILTER_MODE, scene.image.filter.constant()),
-            (SPEC_MEDIA_ENABLED, u32::from(scene.has_media())),
-            (SPEC_CAUSTICS_ENABLED, u32::from(caustics.is_some())),
-            (SPEC_VOLUME_ENABLED, u32::from(volume)),
-            (SPEC_BEAMS_ENABLED, u32::from(caustics.is_some_and(|c| c.has_beams))),
-            (SPEC_RECORD_PATH, u32::from(variant.record_path)),
-            (SPEC_LOOKUP_MODE, variant.lookup.constant()),
-            (SPEC_SAMPLER, variant.sampler.constant()),
-        ],
-    )?)
+) -> Result<PathPass, RenderError> {
+    let constants = RenderConfig::new(gpu, scene, variant, caustics, volume).constants();
+    Ok(match variant.kernel.unwrap_or(PathKernel::auto(backend)) {
+        PathKernel::Megakernel => PathPass::Megakernel(Box::new(Tracer::new(
+            device,
+            backend,
+            shaders::render,
+            shaders::render_rgen,
+            &constants,
+        )?)),
+        PathKernel::Wavefront if backend == Backend::RayQuery => {
+            PathPass::Wavefront(Box::new(Wavefront::new(device, &constants, scene.image.max_depth)?))
+        }
+        PathKernel::Wavefront => return Err(RenderError::WavefrontNeedsRayQueries),
+    })
 }
 
 /// Runs the caustic passes when `variant` asks for them and the scene needs

@@ -8,18 +8,18 @@ use glam::{DAffine3, DMat3, DVec3};
 
 use super::gpu::{GpuCell, GpuLight, GpuLoopBudget, GpuMaterial, GpuObject, GpuPerturbation};
 use super::IntersectMode;
-use crate::geometry::{Aabb, CellParams};
-use crate::sampling::envmap::EnvironmentMap;
-use crate::scene::maps as scene_maps;
-use crate::scene::{Light, Scene, TextureImage};
-use crate::shader_interface::{
+use super::RenderError;
+use crate::gpu::shader_interface::{
     BINDING_CELLS, BINDING_CELL_LISTS, BINDING_FRAME, BINDING_LIGHTS, BINDING_LOOP_BUDGET, BINDING_MATERIALS,
     BINDING_OBJECTS, BINDING_PERTURBATIONS, BINDING_TEXTURES, BINDING_TLAS, MAX_TEXTURES, NO_TEXTURE, SPEC_FAR_RAYS,
     SPEC_LOOP_BUDGET,
 };
-use crate::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
+use crate::model::geometry::{Aabb, CellParams};
+use crate::model::sampling::envmap::EnvironmentMap;
+use crate::model::scene::maps as scene_maps;
+use crate::model::scene::{Light, Scene, TextureImage};
+use crate::model::texture::encoding::{chain_texels, choose_encoding, MapContent, TexelEncoding};
 use crate::vk::{vk, AccelerationStructure, Access, AsInstance, Binding, Buffer, Commands, Device, Image, Sampler};
-use crate::RenderError;
 
 /// Sizes of what a scene put on the GPU.
 #[derive(Clone, Copy, Debug, Default)]
@@ -89,7 +89,7 @@ pub struct GpuScene {
 pub const LOOP_LIMIT: u32 = 65_535;
 
 /// The loop iterations the tracing invocations counted
-/// (glsl/loop_budget.glsl) since [`GpuScene::reset_loop_budget`].
+/// (glsl/intersection/loop_budget.glsl) since [`GpuScene::reset_loop_budget`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoopBudget {
     /// The most loop iterations one invocation counted.
@@ -484,7 +484,7 @@ impl GpuScene {
 
     /// Whether a ray of the scene can start beyond an object's rebase
     /// distance (`GpuObject::rebase_distance`) and so needs the f64 far-ray
-    /// search (glsl/root_search.glsl): decided from how far from the frame's
+    /// search (glsl/intersection/root_search.glsl): decided from how far from the frame's
     /// origin the objects, lights and camera keyframes reach. When it
     /// cannot, the passes' shaders are specialised without that search
     /// (`SPEC_FAR_RAYS`), and near rays skip its per-candidate test.

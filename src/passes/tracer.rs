@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use crate::shaders;
+use crate::gpu::shaders;
 use crate::vk::{
     vk, Backend, Binding, ComputePipeline, Device, RayTracingPipeline, RayTracingStages, ShaderStage, VkError,
 };

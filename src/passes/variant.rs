@@ -4,14 +4,14 @@
 //! scene carries everything else (size, samples, depth, filter, seed), and
 //! every render entry point takes it from there.
 
-use crate::shader_interface::{
+use crate::gpu::shader_interface::{
     INTERSECT_BASE, INTERSECT_BOXES, INTERSECT_FULL, LOOKUP_EWA, LOOKUP_PROBES, SAMPLER_INDEPENDENT, SAMPLER_SOBOL,
     SHADING_ALBEDO, SHADING_FULL, SHADING_GLOSSY_ALBEDO, SHADING_MIRRORED_ALBEDO,
 };
 use crate::vk::Backend;
 
 /// How candidate boxes are intersected (`SPEC_INTERSECT_MODE`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum IntersectMode {
     /// The exact first root of F' (the renderer's mode).
     #[default]
@@ -35,7 +35,7 @@ impl IntersectMode {
 }
 
 /// What the render shader computes at a hit (`SPEC_SHADING_MODE`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum ShadingMode {
     /// The path tracer (the renderer's mode).
     #[default]
@@ -63,7 +63,7 @@ impl ShadingMode {
 }
 
 /// The texture lookup of the filtered modes (`SPEC_LOOKUP_MODE`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum LookupMode {
     /// Trilinear probes along the footprint's major axis (the renderer's
     /// lookup).
@@ -84,9 +84,9 @@ impl LookupMode {
 }
 
 /// Where the path tracer's random decisions take their numbers
-/// (`SPEC_SAMPLER`; glsl/sobol.glsl). The camera jitter keeps its own
+/// (`SPEC_SAMPLER`; glsl/lib/sobol.glsl). The camera jitter keeps its own
 /// stratified sequence in both.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum SamplerMode {
     /// Owen-scrambled Sobol points (Burley 2020), one dimension pair per
     /// decision along the path (the renderer's sampler).
@@ -127,14 +127,57 @@ impl std::fmt::Display for SamplerMode {
 impl std::str::FromStr for SamplerMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        crate::scene::preset::from_name(&Self::ALL, Self::name, "sampler", s)
+        crate::model::scene::preset::from_name(&Self::ALL, Self::name, "sampler", s)
+    }
+}
+
+/// How the render pass runs its paths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum PathKernel {
+    /// One invocation runs a whole path (glsl/render/render.comp, render.rgen).
+    Megakernel,
+    /// Stage kernels over queues of paths (glsl/render/wavefront.glsl,
+    /// [`super::wavefront`]); ray queries only.
+    Wavefront,
+}
+
+impl PathKernel {
+    /// Both, in the order `--kernel` lists them.
+    pub const ALL: [PathKernel; 2] = [PathKernel::Megakernel, PathKernel::Wavefront];
+
+    /// The name `--kernel` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Megakernel => "megakernel",
+            Self::Wavefront => "wavefront",
+        }
+    }
+
+    /// The kernel a render takes when none is asked for, on `backend`: the
+    /// megakernel on the pipeline backend (the wavefront pass traces with
+    /// ray queries), else the one measured faster
+    /// (docs/benchmarks.md, "Megakernel and wavefront").
+    pub fn auto(backend: Backend) -> Self {
+        match backend {
+            Backend::Pipeline => Self::Megakernel,
+            Backend::RayQuery => AUTO_RAY_QUERY_KERNEL,
+        }
+    }
+}
+
+/// What `auto` takes with ray queries (measured: docs/benchmarks.md).
+const AUTO_RAY_QUERY_KERNEL: PathKernel = PathKernel::Megakernel;
+
+impl std::fmt::Display for PathKernel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
 /// Variants of the render shader that switch parts of the work off, to
 /// measure what bounds a render (the benchmark mode) or to test parts of it.
 /// `Default` renders.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct RenderVariant {
     /// How candidate boxes are intersected.
     pub intersect: IntersectMode,
@@ -161,6 +204,10 @@ pub struct RenderVariant {
     /// asked for that the device lacks is an error, never a fallback.
     /// [`RenderOutput::backend`](super::RenderOutput::backend) says which ran.
     pub backend: Option<Backend>,
+    /// How the render pass runs its paths; `None` takes
+    /// [`PathKernel::auto`] for the backend. The wavefront pass on the
+    /// pipeline backend is an error.
+    pub kernel: Option<PathKernel>,
 }
 
 impl Default for RenderVariant {
@@ -174,6 +221,7 @@ impl Default for RenderVariant {
             lookup: LookupMode::Probes,
             sampler: SamplerMode::Sobol,
             backend: None,
+            kernel: None,
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The volumetric-lighting pass (`volume.comp`), run before the render pass
 //! when the scene has fog and a positional light
-//! ([`crate::scene::Scene::needs_volume`]): single scattering toward each
+//! ([`crate::model::scene::Scene::needs_volume`]): single scattering toward each
 //! point, sphere and rect light along the camera rays' first segments, with
 //! shadows (light shafts). The render pass adds its per-pixel mean and
 //! leaves that part out of its own estimate.
@@ -10,7 +10,7 @@
 //! to the first surface in every direction of an octahedral map), then casts
 //! one camera ray per pixel and tests [`VOLUME_POINTS`] points along it
 //! against the maps, with a shadow ray only where a map cannot tell (a
-//! shadow's edge). `glsl/light_map.glsl` says why that converges.
+//! shadow's edge). `glsl/volume/light_map.glsl` says why that converges.
 
 use std::sync::Arc;
 
@@ -18,11 +18,12 @@ use super::gpu::{LightMapPush, VolumePush};
 use super::scene_gpu::GpuScene;
 use super::tracer::Tracer;
 use super::IntersectMode;
-use crate::shader_interface::{BINDING_LIGHT_MAPS, BINDING_VOLUME, RENDER_GROUP, SPEC_INTERSECT_MODE};
+use super::RenderError;
+use crate::gpu::shader_interface::{BINDING_LIGHT_MAPS, BINDING_VOLUME, RENDER_GROUP, SPEC_INTERSECT_MODE};
+use crate::gpu::shaders;
 use crate::vk::{Access, Backend, Binding, Buffer, Commands, Device, GpuTimer, MemoryLocation};
-use crate::{shaders, RenderError};
 
-pub use crate::shader_interface::VOLUME_POINTS;
+pub use crate::gpu::shader_interface::VOLUME_POINTS;
 
 /// Texels on a side of a light map for a `width` x `height` image: the
 /// power of two nearest above the square root of the pixel count (a map
@@ -51,6 +52,12 @@ pub struct VolumeLight {
 }
 
 impl VolumeLight {
+    /// What the render pass reads from the volume pass: its radiance, or
+    /// `placeholder` where the pass did not run (`volume` is `None`).
+    pub fn render_bindings<'a>(volume: Option<&'a VolumeLight>, placeholder: &'a Buffer) -> [(u32, Binding<'a>); 1] {
+        [(BINDING_VOLUME, Binding::Buffer(volume.map_or(placeholder, |v| &v.radiance)))]
+    }
+
     /// Creates the pipelines and buffers for a `width` x `height` image
     /// whose frame parameters are in `frame` (`GpuFrame`), tracing with
     /// `backend`; `positional` are the indices of the scene's point, sphere

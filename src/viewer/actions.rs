@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use crate::scene::{Preset, MAX_IMAGE_SIZE};
+use crate::model::scene::{Preset, MAX_IMAGE_SIZE};
 
 /// One thing the viewer does. Keys and script steps both become actions.
 #[derive(Clone, Debug, PartialEq)]

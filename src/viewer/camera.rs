@@ -2,7 +2,7 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::scene::Camera;
+use crate::model::scene::Camera;
 
 /// Closest the eye may come to the look-at point, as a fraction of the
 /// starting distance.

@@ -31,10 +31,10 @@ use winit::keyboard::{Key, NamedKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
-use crate::denoise::Denoiser;
-use crate::output::{tone_map, write_outputs, ExrPrecision, OutputKind};
+use crate::jobs::denoise::Denoiser;
+use crate::jobs::output::{tone_map, write_outputs, ExrPrecision, OutputKind};
+use crate::model::scene::{Preset, Scene};
 use crate::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
-use crate::scene::{Preset, Scene};
 use crate::vk::{
     surface_extensions, Commands, Device, Instance, PresentResult, Surface, Swapchain, ValidationCounters, VkError,
 };
@@ -415,7 +415,7 @@ impl App {
             let denoise = self.scene.image.denoise && (out.spp >= 2 || out.spp >= target);
             if denoise && due {
                 if let Some(d) = Self::denoiser(&mut self.denoiser) {
-                    match crate::denoise::denoise_output(d, &out, self.scene.image.denoise_quality) {
+                    match crate::jobs::denoise::denoise_output(d, &out, self.scene.image.denoise_quality) {
                         Ok(image) => out.denoised = Some(image),
                         Err(e) => {
                             log::warn!("{e}; showing the samples without denoising");

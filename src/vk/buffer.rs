@@ -125,6 +125,31 @@ impl Buffer {
         unsafe { rec.device.cmd_copy_buffer(rec.cmd, self.raw, dst.raw, &region) };
     }
 
+    /// Records writing the 32-bit `words` at byte `offset` (a multiple of 4)
+    /// from the command buffer itself (`vkCmdUpdateBuffer`, at most 64 KiB:
+    /// a transfer write, [`crate::vk::Access::TransferWrite`]). The buffer
+    /// needs `TRANSFER_DST` usage.
+    pub fn update(&self, rec: Recording<'_>, offset: u64, words: &[u32]) {
+        let bytes: &[u8] = bytemuck::cast_slice(words);
+        assert!(offset.is_multiple_of(4) && offset + bytes.len() as u64 <= self.size && bytes.len() <= 65536);
+        // SAFETY: the buffer is alive while the submission runs (the caller holds it across
+        // `Commands::run`, which waits); offset and size are multiples of 4 within the buffer, at most
+        // 64 KiB, as vkCmdUpdateBuffer requires.
+        unsafe { rec.device.cmd_update_buffer(rec.cmd, self.raw, offset, bytes) };
+    }
+
+    /// Records copying `size` bytes at `offset` of this buffer to the same
+    /// offset of `dst` (a transfer read of this buffer, a transfer write of
+    /// `dst`; `TRANSFER_SRC` and `TRANSFER_DST` usage).
+    pub fn copy_range_to(&self, rec: Recording<'_>, dst: &Buffer, offset: u64, size: u64) {
+        assert!(offset + size <= self.size && offset + size <= dst.size, "copy outside a buffer");
+        let region = [vk::BufferCopy::default().src_offset(offset).dst_offset(offset).size(size)];
+        // SAFETY: both buffers are alive while the submission runs (the caller holds them across
+        // `Commands::run`, which waits); the region lies in both (checked above); the caller's barriers
+        // order the copy.
+        unsafe { rec.device.cmd_copy_buffer(rec.cmd, self.raw, dst.raw, &region) };
+    }
+
     /// Copies `bytes` into the (host-visible) buffer at `offset`.
     pub fn write(&mut self, offset: usize, bytes: &[u8]) {
         self.bytes_mut()[offset..offset + bytes.len()].copy_from_slice(bytes);

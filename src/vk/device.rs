@@ -9,16 +9,12 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::capabilities::{preference, Capabilities, PipelineLimits};
-use super::{Instance, VkError};
+use super::{Instance, VkError, SETUP_HINT};
 
 /// The device extensions the renderer cannot work without; it also needs
 /// ray queries or ray-tracing pipelines (or both), enabled where offered.
 const REQUIRED_EXTENSIONS: [&CStr; 2] =
     [ash::khr::acceleration_structure::NAME, ash::khr::deferred_host_operations::NAME];
-
-/// The command that installs a driver with ray queries.
-pub const SETUP_HINT: &str =
-    "run `make setup` (installs Mesa's lavapipe with VK_KHR_ray_query from bookworm-backports on Debian 12)";
 
 /// A logical device with one compute queue and a memory allocator.
 // Release order: `Drop::drop` waits for idle, drops the `ManuallyDrop` allocator and destroys the device, all

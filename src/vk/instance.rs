@@ -9,6 +9,10 @@ use ash::vk;
 
 use super::VkError;
 
+/// The command that installs a driver with ray queries.
+pub const SETUP_HINT: &str =
+    "run `make setup` (installs Mesa's lavapipe with VK_KHR_ray_query from bookworm-backports on Debian 12)";
+
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// Counts of validation messages by severity, shared with the messenger
@@ -162,7 +166,7 @@ impl Instance {
             Err(e @ (vk::Result::ERROR_INCOMPATIBLE_DRIVER | vk::Result::ERROR_INITIALIZATION_FAILED)) => {
                 return Err(VkError::NoSuitableDevice(format!(
                     "the Vulkan loader found no working driver (ICD) ({e}).\nTo fix: {}",
-                    super::SETUP_HINT
+                    SETUP_HINT
                 )))
             }
             Err(e) => return Err(e.into()),
@@ -185,11 +189,6 @@ impl Instance {
     /// The validation message counters (shared; outlive the instance).
     pub fn counters(&self) -> Arc<ValidationCounters> {
         self.counters.clone()
-    }
-
-    /// True when the validation layer is on.
-    pub fn validation_enabled(&self) -> bool {
-        self.debug.is_some()
     }
 }
 

@@ -30,11 +30,12 @@ pub use ash::vk;
 pub use buffer::Buffer;
 pub use capabilities::{preference, survey, Backend, Capabilities, PipelineLimits, Survey};
 pub use commands::Commands;
-pub use device::{Device, RayTracing, SETUP_HINT};
+pub use device::{Device, RayTracing};
 pub use gpu_allocator::MemoryLocation;
 pub use image::Image;
-pub use instance::{Instance, ValidationCounters};
-pub use pipeline::{Binding, BindingKind, ComputePipeline, PipelineResources};
+pub use instance::{Instance, ValidationCounters, SETUP_HINT};
+pub use pipeline::{Binding, ComputePipeline, PipelineResources};
+pub use reflect::BindingKind;
 pub use rt_pipeline::{RayTracingPipeline, RayTracingStages};
 pub use sampler::Sampler;
 #[cfg(feature = "viewer")]

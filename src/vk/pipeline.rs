@@ -5,43 +5,11 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::reflect::{InterfaceError, ShaderInterface};
+use super::reflect::{BindingKind, InterfaceError, ShaderInterface};
 use super::{AccelerationStructure, Buffer, Device, Image, Sampler, VkError};
 
-/// What a descriptor binding holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BindingKind {
-    /// A top-level acceleration structure.
-    AccelerationStructure,
-    /// A storage buffer.
-    StorageBuffer,
-    /// A storage image (GENERAL layout).
-    StorageImage,
-    /// An array of this many combined image samplers (SHADER_READ_ONLY_OPTIMAL).
-    SampledImages(u32),
-}
-
-impl BindingKind {
-    /// The Vulkan descriptor type.
-    pub fn descriptor_type(self) -> vk::DescriptorType {
-        match self {
-            Self::AccelerationStructure => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
-            Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
-            Self::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
-            Self::SampledImages(_) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-        }
-    }
-
-    /// Descriptors at the binding (array elements).
-    pub fn count(self) -> u32 {
-        match self {
-            Self::SampledImages(n) => n,
-            _ => 1,
-        }
-    }
-}
-
 /// A resource bound at one binding.
+#[derive(Clone)]
 pub enum Binding<'a> {
     /// An acceleration structure.
     AccelerationStructure(&'a AccelerationStructure),
@@ -365,6 +333,22 @@ impl ComputePipeline {
         // the set names are kept alive by the caller until `Commands::run` has waited for the submission.
         // Group counts within maxComputeWorkGroupCount are the caller's to respect (not checked).
         unsafe { raw.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+    }
+
+    /// Records binding the pipeline and set, pushing `constants`, and a
+    /// dispatch whose workgroup counts the device reads from `args` at byte
+    /// `offset` (three `u32`, written by earlier work: the caller's barrier
+    /// names [`crate::vk::Access::IndirectRead`]). `args` needs
+    /// `INDIRECT_BUFFER` usage.
+    pub fn dispatch_indirect(&self, cmd: vk::CommandBuffer, constants: &[u8], args: &super::Buffer, offset: u64) {
+        let raw = &self.resources.device.raw;
+        // SAFETY: as in `dispatch`: a recording command buffer of this device and a live pipeline.
+        unsafe { raw.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.raw) };
+        self.resources.record(cmd, vk::PipelineBindPoint::COMPUTE, constants);
+        // SAFETY: the pipeline, set and push constants are bound above; `args` is alive until the
+        // submission has finished (the caller holds it across `Commands::run`, which waits), has
+        // INDIRECT_BUFFER usage (the caller's) and holds three u32 at the 4-aligned `offset`.
+        unsafe { raw.cmd_dispatch_indirect(cmd, args.raw, offset) };
     }
 }
 

@@ -4,7 +4,7 @@
 //! the byte layout of every struct in its buffers and push constants.
 //! Pipelines build their descriptor set layouts from it and check what the
 //! host binds and specialises against it, so the `BINDING_*` and `SPEC_*`
-//! numbers of `src/shader_interface.rs` are the only place both sides meet;
+//! numbers of `src/gpu/shader_interface.rs` are the only place both sides meet;
 //! the GPU structs of `passes::gpu` are checked member by member against
 //! the layouts here (`tests/scene/interface.rs`).
 
@@ -13,7 +13,40 @@ use std::collections::{BTreeMap, HashMap};
 use rspirv::dr::{Instruction, Operand};
 use rspirv::spirv::{Decoration, Op, StorageClass};
 
-use super::BindingKind;
+use ash::vk;
+
+/// What a descriptor binding holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    /// A top-level acceleration structure.
+    AccelerationStructure,
+    /// A storage buffer.
+    StorageBuffer,
+    /// A storage image (GENERAL layout).
+    StorageImage,
+    /// An array of this many combined image samplers (SHADER_READ_ONLY_OPTIMAL).
+    SampledImages(u32),
+}
+
+impl BindingKind {
+    /// The Vulkan descriptor type.
+    pub fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            Self::AccelerationStructure => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
+            Self::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            Self::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+            Self::SampledImages(_) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        }
+    }
+
+    /// Descriptors at the binding (array elements).
+    pub fn count(self) -> u32 {
+        match self {
+            Self::SampledImages(n) => n,
+            _ => 1,
+        }
+    }
+}
 
 /// What does not match between a shader and the host.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

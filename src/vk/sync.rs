@@ -56,6 +56,8 @@ pub enum Access {
     /// Traced by shaders of a stage (an acceleration structure read by ray
     /// queries or `traceRays`).
     Trace(ShaderStage),
+    /// Read as the arguments of an indirect dispatch.
+    IndirectRead,
     /// Written by an acceleration-structure build (which also reads its
     /// inputs, a TLAS build its BLASes).
     AccelerationStructureBuild,
@@ -71,6 +73,7 @@ impl Access {
             Access::TransferRead | Access::TransferWrite => vk::PipelineStageFlags::TRANSFER,
             Access::ShaderRead(s) | Access::ShaderWrite(s) | Access::Trace(s) => s.flags(),
             Access::AccelerationStructureBuild => vk::PipelineStageFlags::ACCELERATION_STRUCTURE_BUILD_KHR,
+            Access::IndirectRead => vk::PipelineStageFlags::DRAW_INDIRECT,
             Access::HostRead | Access::HostWrite => vk::PipelineStageFlags::HOST,
         }
     }
@@ -82,6 +85,7 @@ impl Access {
             Access::ShaderRead(_) => vk::AccessFlags::SHADER_READ,
             Access::ShaderWrite(_) => vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
             Access::Trace(_) => vk::AccessFlags::ACCELERATION_STRUCTURE_READ_KHR,
+            Access::IndirectRead => vk::AccessFlags::INDIRECT_COMMAND_READ,
             Access::AccelerationStructureBuild => {
                 vk::AccessFlags::ACCELERATION_STRUCTURE_READ_KHR | vk::AccessFlags::ACCELERATION_STRUCTURE_WRITE_KHR
             }

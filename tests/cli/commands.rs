@@ -235,15 +235,15 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
 
     let exr = Exr::read(&outdir.path().join("out.exr"));
     assert_eq!(exr.size(), (WIDTH, HEIGHT));
-    let mut want = quadray::output::EXR_CHANNELS.map(String::from).to_vec();
-    want.extend(quadray::output::EXR_MAX_SAMPLE_CHANNELS.map(String::from));
-    want.extend(quadray::output::EXR_DENOISE_CHANNELS.map(String::from));
+    let mut want = quadray::jobs::output::EXR_CHANNELS.map(String::from).to_vec();
+    want.extend(quadray::jobs::output::EXR_MAX_SAMPLE_CHANNELS.map(String::from));
+    want.extend(quadray::jobs::output::EXR_DENOISE_CHANNELS.map(String::from));
     want.sort();
     assert_eq!(exr.names(), want);
-    for name in quadray::output::EXR_CHANNELS
+    for name in quadray::jobs::output::EXR_CHANNELS
         .iter()
-        .chain(&quadray::output::EXR_MAX_SAMPLE_CHANNELS)
-        .chain(&quadray::output::EXR_DENOISE_CHANNELS)
+        .chain(&quadray::jobs::output::EXR_MAX_SAMPLE_CHANNELS)
+        .chain(&quadray::jobs::output::EXR_DENOISE_CHANNELS)
     {
         assert!(matches!(exr.samples(name), FlatSamples::F32(_)), "{name} should hold 32-bit floats");
     }
@@ -258,7 +258,7 @@ fn sphere_aovs_radiance_and_png_match_the_analytic_scene() {
     let normal = exr.vec3(["normal.X", "normal.Y", "normal.Z"]);
     let albedo = exr.vec3(["albedo.R", "albedo.G", "albedo.B"]);
     let rgb = exr.vec3(["R", "G", "B"]);
-    let [da, db, dc, dx, dy, dz] = quadray::output::EXR_DENOISE_CHANNELS;
+    let [da, db, dc, dx, dy, dz] = quadray::jobs::output::EXR_DENOISE_CHANNELS;
     let feature_albedo = exr.vec3([da, db, dc]);
     let feature_normal = exr.vec3([dx, dy, dz]);
     let mut max_feature_error = 0f64;
@@ -456,11 +456,11 @@ fn half_exr_only_with_size_overrides_and_validation_from_the_environment() {
     assert_eq!(entries(outdir.path()), ["half.exr"]);
     let exr = Exr::read(&out);
     assert_eq!(exr.size(), (w, h));
-    for name in quadray::output::EXR_CHANNELS {
+    for name in quadray::jobs::output::EXR_CHANNELS {
         assert!(matches!(exr.samples(name), FlatSamples::F16(_)), "{name} should hold half floats");
     }
     // Sample indices need more than f16's 11 bits: these stay 32-bit.
-    for name in quadray::output::EXR_MAX_SAMPLE_CHANNELS {
+    for name in quadray::jobs::output::EXR_MAX_SAMPLE_CHANNELS {
         assert!(matches!(exr.samples(name), FlatSamples::F32(_)), "{name} should hold 32-bit floats");
     }
     let depth = exr.channel("depth");
@@ -738,16 +738,16 @@ fn without_ray_queries_every_pass_runs_through_the_pipeline() {
     let reference: Vec<&str> =
         ["render", scene, "-o", "rq.exr", "--backend", "ray-query"].into_iter().chain(size).collect();
     render_ok(&reference, dir.path(), &[]);
-    let file = |name: &str| quadray::output::read_render_exr(&dir.path().join(name)).unwrap();
+    let file = |name: &str| quadray::jobs::output::read_render_exr(&dir.path().join(name)).unwrap();
     let (rq, pipe) = (file("rq.exr"), file("pipeline.exr"));
     // The images say which backend made them.
-    let backend = |f: &quadray::output::ExrFile| {
-        f.metadata.iter().find(|(k, _)| k == quadray::output::METADATA_BACKEND).map(|(_, v)| v.clone())
+    let backend = |f: &quadray::jobs::output::ExrFile| {
+        f.metadata.iter().find(|(k, _)| k == quadray::jobs::output::METADATA_BACKEND).map(|(_, v)| v.clone())
     };
     assert_eq!(backend(&rq).as_deref(), Some("ray-query"));
     assert_eq!(backend(&pipe).as_deref(), Some("pipeline"));
     let (a, b) = (rq.output, pipe.output);
-    let flip = quadray::metrics::flip_mean(&a, &b, 0.0).unwrap();
+    let flip = quadray::tools::metrics::flip_mean(&a, &b, 0.0).unwrap();
     println!("lens_fog without ray queries against ray queries: FLIP {flip:.6}");
     assert!(flip <= 0.001, "FLIP {flip}");
     let refused: Vec<&str> =
@@ -807,14 +807,14 @@ fn denoise_keeps_the_raw_image_and_without_the_library_writes_nothing() {
     );
     assert_eq!(entries(dir), ["d.exr", "d.png"]);
     let exr = Exr::read(&dir.join("d.exr"));
-    for name in quadray::output::EXR_NOISY_CHANNELS.iter().chain(&quadray::output::EXR_DENOISE_CHANNELS) {
+    for name in quadray::jobs::output::EXR_NOISY_CHANNELS.iter().chain(&quadray::jobs::output::EXR_DENOISE_CHANNELS) {
         assert!(exr.names().iter().any(|n| n == name), "{name} missing from {:?}", exr.names());
     }
-    let file = quadray::output::read_render_exr(&dir.join("d.exr")).unwrap();
+    let file = quadray::jobs::output::read_render_exr(&dir.join("d.exr")).unwrap();
     let denoised = file.output.denoised.as_ref().expect("the denoised image");
     assert_ne!(denoised, &file.output.radiance, "the denoised image is the raw one");
-    assert_eq!(file.output.radiance, exr.vec3(quadray::output::EXR_NOISY_CHANNELS), "the raw radiance is kept");
-    assert!(file.metadata.iter().any(|(k, v)| k == quadray::output::METADATA_DENOISED && v.contains("2.5.1")));
+    assert_eq!(file.output.radiance, exr.vec3(quadray::jobs::output::EXR_NOISY_CHANNELS), "the raw radiance is kept");
+    assert!(file.metadata.iter().any(|(k, v)| k == quadray::jobs::output::METADATA_DENOISED && v.contains("2.5.1")));
     // The PNG shows the denoised image.
     let png = image::open(dir.join("d.png")).unwrap().to_rgb8();
     let i = 18 * 48 + 24;
@@ -825,7 +825,7 @@ fn denoise_keeps_the_raw_image_and_without_the_library_writes_nothing() {
     let again = dir.join("again.exr");
     let log = render_ok(&["denoise", dir.join("d.exr").to_str().unwrap(), "-o", again.to_str().unwrap()], dir, &[]);
     assert!(log.contains("denoised: Intel Open Image Denoise"), "{log}");
-    let twice = quadray::output::read_render_exr(&again).unwrap().output;
+    let twice = quadray::jobs::output::read_render_exr(&again).unwrap().output;
     assert_eq!(twice.radiance, file.output.radiance);
     let most = denoised.iter().flatten().zip(twice.denoised.as_ref().unwrap().iter().flatten());
     for (a, b) in most {
@@ -880,16 +880,16 @@ fn the_default_render_is_denoised_with_the_raw_radiance_kept() {
     let stderr = render_ok(&["render", "--width", "32", "--height", "24", "--spp", "2"], dir.path(), &[]);
     assert!(stderr.contains("denoised: Intel Open Image Denoise"), "{stderr}");
     assert_eq!(entries(dir.path()), ["render.exr", "render.png"]);
-    let exr = quadray::output::read_render_exr(&dir.path().join("render.exr")).unwrap();
+    let exr = quadray::jobs::output::read_render_exr(&dir.path().join("render.exr")).unwrap();
     assert!(exr.output.denoised.is_some(), "the EXR's RGB is the denoised image, noisy.RGB the raw");
-    assert!(exr.metadata.iter().any(|(k, _)| k == quadray::output::METADATA_DENOISED));
+    assert!(exr.metadata.iter().any(|(k, _)| k == quadray::jobs::output::METADATA_DENOISED));
     // --no-denoise: the raw image alone.
     render_ok(
         &["render", "--width", "32", "--height", "24", "--spp", "2", "--no-denoise", "-o", "raw"],
         dir.path(),
         &[],
     );
-    let raw = quadray::output::read_render_exr(&dir.path().join("raw.exr")).unwrap();
+    let raw = quadray::jobs::output::read_render_exr(&dir.path().join("raw.exr")).unwrap();
     assert!(raw.output.denoised.is_none());
 }
 

@@ -413,7 +413,7 @@ fn bad_farm_settings_are_clear_errors_that_write_nothing() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && stderr.contains("is Slurm installed"), "{stderr}");
-    let farm = quadray::farm::Farm::open(&tmp.path().join("f")).unwrap();
+    let farm = quadray::jobs::farm::Farm::open(&tmp.path().join("f")).unwrap();
     assert_eq!((farm.manifest.tiles, farm.manifest.frames.clone()), (2, Some(vec![0, 1])));
     assert!(farm.manifest.submissions.is_empty());
     // A dry run needs no Slurm: it prints what it would submit.
@@ -429,5 +429,5 @@ fn bad_farm_settings_are_clear_errors_that_write_nothing() {
     assert_eq!(lines.len(), 2, "{stdout}");
     assert!(lines[0].starts_with("sbatch ") && lines[0].contains("--array=0-3"), "{stdout}");
     assert!(lines[1].contains("--dependency=afterok:<array job>") && lines[1].ends_with("merge.sh"), "{stdout}");
-    assert!(quadray::farm::Farm::open(&tmp.path().join("f")).unwrap().manifest.submissions.is_empty());
+    assert!(quadray::jobs::farm::Farm::open(&tmp.path().join("f")).unwrap().manifest.submissions.is_empty());
 }

@@ -76,7 +76,7 @@ fn interrupt_and_resume(scene_file: &str, size: &[&str], spp: u32, dir: &Path) {
     assert_eq!(out.status.code(), Some(75), "status after SIGTERM:\n{stderr}");
     assert!(stderr.contains("interrupted: wrote the image so far"), "{stderr}");
     assert!(dir.join("c.ckpt").exists() && dir.join("part.exr").exists() && dir.join("part.png").exists());
-    let part = quadray::output::read_render_exr(&dir.join("part.exr")).unwrap();
+    let part = quadray::jobs::output::read_render_exr(&dir.join("part.exr")).unwrap();
     let reached: u32 = part.output.spp;
     println!("{scene_file}: stopped at {reached} of {spp} spp");
     assert!(reached < spp.parse().unwrap(), "the render finished before the signal: {stderr}");
@@ -122,7 +122,7 @@ fn four_tiles_merge_into_the_whole_render() {
     for i in 0..4 {
         let name = format!("tile{i}.exr");
         ok(&refs(&with(&["--tile", &format!("{i}/4"), "-o", &name])), d);
-        let file = quadray::output::read_render_exr(&d.join(&name)).unwrap();
+        let file = quadray::jobs::output::read_render_exr(&d.join(&name)).unwrap();
         let expected = quadray::passes::PixelBounds::tile(i, 4, 300, 200).unwrap();
         assert_eq!(file.output.bounds, expected, "data window of {name}");
         assert_eq!(file.output.frame_size, (300, 200), "display window of {name}");
@@ -133,7 +133,7 @@ fn four_tiles_merge_into_the_whole_render() {
     ok(&["merge", &tiles[2], &tiles[0], &tiles[3], &tiles[1], "-o", "merged"], d);
     same_bytes(&d.join("full.exr"), &d.join("merged.exr"));
     same_bytes(&d.join("full.png"), &d.join("merged.png"));
-    let merged = quadray::output::read_render_exr(&d.join("merged.exr")).unwrap();
+    let merged = quadray::jobs::output::read_render_exr(&d.join("merged.exr")).unwrap();
     assert!(!merged.output.aov.is_empty() && !merged.output.max_sample.is_empty(), "AOVs merged");
 
     // A missing tile, an overlap and a tile of another seed: errors, no files.
@@ -161,8 +161,8 @@ fn a_crop_is_the_same_pixels_as_the_whole_render() {
     ok(&full, d);
     let crop: Vec<&str> = base.iter().copied().chain(["--crop", "17,61,5,44", "-o", "crop.exr"]).collect();
     ok(&crop, d);
-    let full = quadray::output::read_render_exr(&d.join("full.exr")).unwrap().output;
-    let crop = quadray::output::read_render_exr(&d.join("crop.exr")).unwrap().output;
+    let full = quadray::jobs::output::read_render_exr(&d.join("full.exr")).unwrap().output;
+    let crop = quadray::jobs::output::read_render_exr(&d.join("crop.exr")).unwrap().output;
     let bounds = quadray::passes::PixelBounds { x0: 17, x1: 61, y0: 5, y1: 44 };
     assert_eq!(crop.bounds, bounds);
     assert_eq!(crop.radiance, bounds.extract(&full.radiance, 90));
@@ -186,8 +186,8 @@ fn a_frame_range_renders_numbered_frames_equal_to_single_frames() {
     same_bytes(&d.join("move.0002.exr"), &d.join("single.0002.exr"));
     same_bytes(&d.join("move.0002.png"), &d.join("single.0002.png"));
     // The camera moves: the frames differ, and each says which it is.
-    let f0 = quadray::output::read_render_exr(&d.join("move.0000.exr")).unwrap();
-    let f1 = quadray::output::read_render_exr(&d.join("move.0001.exr")).unwrap();
+    let f0 = quadray::jobs::output::read_render_exr(&d.join("move.0000.exr")).unwrap();
+    let f1 = quadray::jobs::output::read_render_exr(&d.join("move.0001.exr")).unwrap();
     assert_ne!(f0.output.radiance, f1.output.radiance);
     assert!(f1.metadata.contains(&("quadray.frame".to_string(), "1".to_string())), "{:?}", f1.metadata);
     let bad: Vec<&str> = base.iter().copied().chain(["--frames", "3-1", "-o", "x"]).collect();
@@ -203,7 +203,7 @@ fn a_time_limit_writes_what_it_has_and_a_checkpoint_to_resume() {
         base.iter().copied().chain(["--time-limit", "0.5", "--checkpoint", "t.ckpt", "-o", "part"]).collect();
     let stderr = ok(&limited, d);
     assert!(stderr.contains("time limit reached: wrote the image so far"), "{stderr}");
-    let part = quadray::output::read_render_exr(&d.join("part.exr")).unwrap();
+    let part = quadray::jobs::output::read_render_exr(&d.join("part.exr")).unwrap();
     let meta = |k: &str| part.metadata.iter().find(|(n, _)| n == k).map(|(_, v)| v.clone());
     println!("time limit 0.5 s: {} of 4000 spp", part.output.spp);
     assert!(part.output.spp < 4000);
@@ -230,9 +230,9 @@ fn denoised_tiles_merge_into_their_raw_radiance() {
     }
     let log = ok(&["merge", "t0.exr", "t1.exr", "-o", "merged.exr"], d);
     assert!(log.contains("denoised images are left out"), "{log}");
-    let merged = quadray::output::read_render_exr(&d.join("merged.exr")).unwrap();
-    let raw = quadray::output::read_render_exr(&d.join("raw.exr")).unwrap();
+    let merged = quadray::jobs::output::read_render_exr(&d.join("merged.exr")).unwrap();
+    let raw = quadray::jobs::output::read_render_exr(&d.join("raw.exr")).unwrap();
     assert!(merged.output.denoised.is_none());
     assert!(merged.output.radiance == raw.output.radiance, "the merged radiance is not the raw render's");
-    assert!(!merged.metadata.iter().any(|(k, _)| k == quadray::output::METADATA_DENOISED));
+    assert!(!merged.metadata.iter().any(|(k, _)| k == quadray::jobs::output::METADATA_DENOISED));
 }

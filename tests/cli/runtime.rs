@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use quadray::output::{read_render_exr, METADATA_DRIVER};
+use quadray::jobs::output::{read_render_exr, METADATA_DRIVER};
 use quadray::vk::runtime::{restore_env, Runtime, BUNDLED_RUNTIME};
 
 /// The runtime `make setup` fetched, if it did.
@@ -176,7 +176,7 @@ fn the_system_driver_renders_the_test_scenes_as_the_runtime_does() {
         };
         let runtime = render("runtime", &[]);
         let system = render("system", &["--system-vulkan"]);
-        let driver = |f: &quadray::output::ExrFile| {
+        let driver = |f: &quadray::jobs::output::ExrFile| {
             f.metadata.iter().find(|(k, _)| k == METADATA_DRIVER).map(|(_, v)| v.clone()).unwrap_or_default()
         };
         let (d_runtime, d_system) = (driver(&runtime), driver(&system));

@@ -88,10 +88,10 @@ fn png_flip(reference: &Path, test: &Path) -> f64 {
 fn exr_flip(reference: &Path, test: &Path) -> f64 {
     let read = |p: &Path| {
         let (width, height, texels) =
-            quadray::texture::read_exr_image(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            quadray::model::texture::read_exr_image(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
         quadray::passes::RenderOutput::from_radiance(width, height, texels.iter().map(|t| [t[0], t[1], t[2]]).collect())
     };
-    quadray::metrics::flip_mean(&read(reference), &read(test), 0.0).expect("same size")
+    quadray::tools::metrics::flip_mean(&read(reference), &read(test), 0.0).expect("same size")
 }
 
 #[test]
@@ -161,7 +161,7 @@ fn window_screenshots_match_the_offscreen_render_through_resize_and_close() {
         assert!(shown < FLIP_BOUND && window < FLIP_BOUND && radiance < FLIP_BOUND);
         // The denoised screenshots keep the raw radiance beside the
         // denoised; the raw one has only the raw.
-        let file = quadray::output::read_render_exr(&path(&format!("{name}.exr"))).unwrap();
+        let file = quadray::jobs::output::read_render_exr(&path(&format!("{name}.exr"))).unwrap();
         assert_eq!(file.output.denoised.is_some(), denoise == "--denoise", "{name}.exr");
     }
     // Denoised and raw differ (the key did something).

@@ -5,8 +5,8 @@
 use std::sync::Arc;
 
 use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3};
-use quadray::geometry::{Aabb, FunctionalObject, Perturbation, Quadric};
-use quadray::scene::{Camera, ImageSettings, Light, Material, Scene, SceneObject};
+use quadray::model::geometry::{Aabb, FunctionalObject, Perturbation, Quadric};
+use quadray::model::scene::{Camera, ImageSettings, Light, Material, Scene, SceneObject};
 use quadray::vk::{Commands, Context, ValidationCounters};
 
 /// A headless context with the Khronos validation layer on.
@@ -18,7 +18,29 @@ pub fn context() -> Context {
 /// The scene file `scenes/<relative>` of the project, parsed.
 pub fn project_scene(relative: &str) -> Scene {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(relative);
-    quadray::scene::load_scene(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    quadray::model::scene::load_scene(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Every test scene (`scenes/tests/*.toml`) at 64x48 and 4 spp with its own
+/// depth, by file name, sorted; at least nine of them.
+pub fn test_scenes() -> Vec<(String, Scene)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tests");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 9, "the test scenes: {names:?}");
+    names
+        .into_iter()
+        .map(|name| {
+            let mut scene = project_scene(&format!("tests/{name}"));
+            let depth = scene.image.max_depth;
+            set_image(&mut scene, (64, 48), 4, depth);
+            (name, scene)
+        })
+        .collect()
 }
 
 /// Points the camera of `scene` from `position` at `look_at`.
@@ -131,7 +153,7 @@ pub fn random_unit(rng: &mut rand_pcg::Pcg64) -> DVec3 {
 
 /// `n` bumps spread over a sphere of radius `on` (see `geometry::scatter`).
 pub fn spread_bumps(n: usize, on: f64, r: f64, f: f64, alternate: bool) -> Vec<Perturbation> {
-    quadray::geometry::scatter::spread_bumps(n, DVec3::splat(on), r, f, alternate)
+    quadray::model::geometry::scatter::spread_bumps(n, DVec3::splat(on), r, f, alternate)
 }
 
 /// An object from its parts.
@@ -307,7 +329,7 @@ pub fn compare_with_brute_force(name: &str, reference_spp: u32, spp: u32) -> Bru
 pub fn equal_time(
     name: &str,
     file: &str,
-    scene: &quadray::scene::Scene,
+    scene: &quadray::model::scene::Scene,
     reference: quadray::passes::RenderOutput,
     what: &str,
     spp: u32,
@@ -327,10 +349,10 @@ pub fn equal_time(
     let per_sample = probe.seconds / spp as f64;
     scene.image.spp = ((EQUAL_TIME_MARGIN * fast.seconds / per_sample).ceil() as u32).max(spp);
     let brute = if scene.image.spp == spp { probe } else { render_variant_validated(&scene, brute_force) };
-    let flip_fast = quadray::metrics::flip_mean(&reference, &fast, 0.0).unwrap();
-    let flip_brute = quadray::metrics::flip_mean(&reference, &brute, 0.0).unwrap();
-    let rel_fast = quadray::metrics::relative_mse(&reference, &fast).unwrap();
-    let rel_brute = quadray::metrics::relative_mse(&reference, &brute).unwrap();
+    let flip_fast = quadray::tools::metrics::flip_mean(&reference, &fast, 0.0).unwrap();
+    let flip_brute = quadray::tools::metrics::flip_mean(&reference, &brute, 0.0).unwrap();
+    let rel_fast = quadray::tools::metrics::relative_mse(&reference, &fast).unwrap();
+    let rel_brute = quadray::tools::metrics::relative_mse(&reference, &brute).unwrap();
     println!(
         "{name}: passes at {spp} spp in {:.2} s GPU; brute force at {} spp in {:.2} s ({:.2}x the time); \
          against {what}: relMSE {rel_fast:.5} against {rel_brute:.5} ({:.2}x), FLIP {flip_fast:.4} against \
@@ -344,7 +366,7 @@ pub fn equal_time(
     if let Ok(dir) = std::env::var("QUADRAY_TEST_IMAGES") {
         let dir = std::path::Path::new(&dir);
         for (kind, out) in [("reference", &reference), ("passes", &fast), ("brute", &brute)] {
-            quadray::output::write_png(out, 0.0, &dir.join(format!("{name}_{kind}.png"))).unwrap();
+            quadray::jobs::output::write_png(out, 0.0, &dir.join(format!("{name}_{kind}.png"))).unwrap();
         }
     }
     if let Ok(path) = std::env::var("QUADRAY_EQUAL_TIME") {
@@ -404,8 +426,8 @@ impl Agreement {
             .count();
         Self {
             max_channel,
-            flip: quadray::metrics::flip_mean(a, b, 0.0).unwrap(),
-            relmse: quadray::metrics::relative_mse(a, b).unwrap(),
+            flip: quadray::tools::metrics::flip_mean(a, b, 0.0).unwrap(),
+            relmse: quadray::tools::metrics::relative_mse(a, b).unwrap(),
             differing,
             pixels: a.radiance.len(),
         }

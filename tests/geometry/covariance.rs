@@ -1,7 +1,7 @@
-//! Closed-form checks of the covariance-tracing operators (`src/covariance.rs`).
+//! Closed-form checks of the covariance-tracing operators (`src/model/covariance.rs`).
 
 use glam::{DMat2, DMat4, DVec4};
-use quadray::covariance::Covariance4;
+use quadray::model::covariance::Covariance4;
 
 /// Largest |a - b| over the entries, relative to the largest |b| entry (or 1).
 fn rel_err4(a: DMat4, b: DMat4) -> f64 {

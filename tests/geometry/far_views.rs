@@ -25,10 +25,10 @@
 use crate::common;
 
 use glam::{DAffine3, DQuat, DVec3};
-use quadray::geometry::{reference, CellParams, FunctionalObject, Quadric};
+use quadray::gpu::shader_interface::NO_HIT;
+use quadray::model::geometry::{reference, CellParams, FunctionalObject, Quadric};
 use quadray::passes::gpu::GpuRay;
 use quadray::passes::{GpuScene, IntersectMode, ProbePass};
-use quadray::shader_interface::NO_HIT;
 use quadray::vk::Backend;
 
 const DISTANCES: [f64; 5] = [1e3, 1e4, 1e5, 1e6, 1e7];

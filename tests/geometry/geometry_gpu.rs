@@ -16,12 +16,12 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3};
-use quadray::geometry::{reference, Aabb, CellParams};
+use quadray::gpu::shader_interface::NO_HIT;
+use quadray::model::geometry::{reference, Aabb, CellParams};
+use quadray::model::scene::SceneObject;
 use quadray::passes::gpu::{GpuHit, GpuRay};
 use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
-use quadray::scene::SceneObject;
-use quadray::shader_interface::NO_HIT;
 use quadray::vk::Backend;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -41,7 +41,7 @@ const MAX_NORMAL_DEGREES: f64 = 0.1;
 const ON_SURFACE_MAX_DEPTH_ERROR: f64 = 1e-4;
 const FAR_MAX_DEPTH_ERROR: f64 = 1e-5;
 /// Rays from 1e3..1e4 away: the intersection forms the object-space ray and
-/// the point it searches around in f64 (`glsl/intersect.glsl`), so they are
+/// the point it searches around in f64 (`glsl/intersection/intersect.glsl`), so they are
 /// held to the same bound as nearby rays. (With the f32 transform of the
 /// hardware the normals of the sharpest bumps were off by up to 3°.)
 const FAR_MAX_NORMAL_DEGREES: f64 = MAX_NORMAL_DEGREES;

@@ -16,8 +16,8 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
-use quadray::geometry::{FunctionalObject, Quadric};
-use quadray::scene::{Light, Material, Scene};
+use quadray::model::geometry::{FunctionalObject, Quadric};
+use quadray::model::scene::{Light, Material, Scene};
 
 const SIZE: u32 = 64;
 

@@ -16,10 +16,10 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3};
-use quadray::geometry::{reference, CellParams, FunctionalObject, Quadric};
+use quadray::gpu::shader_interface::NO_HIT;
+use quadray::model::geometry::{reference, CellParams, FunctionalObject, Quadric};
 use quadray::passes::gpu::GpuRay;
 use quadray::passes::{GpuScene, IntersectMode, ProbePass};
-use quadray::shader_interface::NO_HIT;
 use quadray::vk::Backend;
 
 /// Rays per side of the grid (`make bench` uses 512 and more).

@@ -21,11 +21,11 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3};
-use quadray::geometry::{Aabb, CellParams, FunctionalObject, Perturbation, Quadric};
+use quadray::gpu::shader_interface::NO_HIT;
+use quadray::model::geometry::{Aabb, CellParams, FunctionalObject, Perturbation, Quadric};
 use quadray::passes::gpu::GpuRay;
 use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
-use quadray::shader_interface::NO_HIT;
 
 const F32_EPSILON: f64 = 1.0 / 8_388_608.0;
 const CONDITIONING_FACTOR: f64 = 64.0;

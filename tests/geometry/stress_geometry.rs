@@ -20,11 +20,11 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3};
-use quadray::geometry::{reference, CellParams, FunctionalObject, Quadric};
+use quadray::gpu::shader_interface::NO_HIT;
+use quadray::model::geometry::{reference, CellParams, FunctionalObject, Quadric};
 use quadray::passes::gpu::GpuRay;
 use quadray::passes::IntersectMode;
 use quadray::passes::{GpuScene, ProbePass};
-use quadray::shader_interface::NO_HIT;
 use quadray::vk::Commands;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -79,7 +79,7 @@ fn measure(
     let bounds = shape.bounds().unwrap();
     let centre = transform.translation;
     let inverse = transform.inverse();
-    let object = quadray::scene::SceneObject { transform, ..common::object("shape", shape.clone(), transform) };
+    let object = quadray::model::scene::SceneObject { transform, ..common::object("shape", shape.clone(), transform) };
     let scene = common::scene_with(vec![object]);
     let gpu = GpuScene::with_origin(&ctx.device, cmds, &scene, &CellParams::default(), origin).unwrap();
     let rays: Vec<GpuRay> = (0..rays)
@@ -213,7 +213,7 @@ fn scales_and_offsets_against_the_f64_reference() {
 }
 
 /// Whether `p` lies within 1e-5 of the box's size of one of its faces.
-fn on_box_rim(b: &quadray::geometry::Aabb, p: DVec3) -> bool {
+fn on_box_rim(b: &quadray::model::geometry::Aabb, p: DVec3) -> bool {
     let tol = 1e-5 * (b.max - b.min).max_element();
     let inside = p.cmpge(b.min - tol).all() && p.cmple(b.max + tol).all();
     let near_face = (p - b.min).abs().min_element() <= tol || (b.max - p).abs().min_element() <= tol;
@@ -293,7 +293,7 @@ fn extremes() -> Vec<Extreme> {
         shape: FunctionalObject {
             base: Quadric::from_coefficients([-1.0, 1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
             perturbations: vec![],
-            clip: Some(quadray::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
+            clip: Some(quadray::model::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
         },
         rays: RAYS,
         aim: 0.05,
@@ -309,7 +309,7 @@ fn extremes() -> Vec<Extreme> {
             shape: FunctionalObject {
                 base: Quadric::from_coefficients([eps, 0.0, eps, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
                 perturbations: vec![],
-                clip: Some(quadray::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
+                clip: Some(quadray::model::geometry::Aabb::new(DVec3::splat(-1.0), DVec3::splat(1.0))),
             },
             rays: RAYS,
             aim: 0.9,

@@ -30,20 +30,9 @@ const MAX_FLIP: f64 = 0.001;
 
 #[test]
 fn every_test_scene_renders_the_same_with_both_backends() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tests");
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".toml"))
-        .collect();
-    names.sort();
-    assert!(names.len() >= 9, "the test scenes: {names:?}");
     println!("{:<22} {:>12} {:>10} {:>12} {:>14}", "scene", "max channel", "FLIP", "relMSE", "pixels differ");
     let mut failures = Vec::new();
-    for name in names {
-        let mut scene = common::project_scene(&format!("tests/{name}"));
-        let depth = scene.image.max_depth;
-        common::set_image(&mut scene, (64, 48), 4, depth);
+    for (name, scene) in common::test_scenes() {
         let rq = common::render_variant_validated(
             &scene,
             RenderVariant { backend: Some(Backend::RayQuery), ..Default::default() },

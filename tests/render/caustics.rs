@@ -14,9 +14,9 @@
 
 use crate::common;
 
+use quadray::model::sampling::fresnel::fresnel_dielectric;
+use quadray::model::scene::parse_scene;
 use quadray::passes::RenderVariant;
-use quadray::sampling::fresnel::fresnel_dielectric;
-use quadray::scene::parse_scene;
 
 /// Relative error allowed on the deposited flux: the grid's boundary rays
 /// deposit part of their flux (about 1 / (rays across the ball)), and the
@@ -189,7 +189,7 @@ fn glass_vessel_at_equal_time() {
     let mut scene = common::project_scene("glass_vessel.toml");
     (scene.image.width, scene.image.height, scene.image.seed) = (256, 192, 1);
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results/caustics/vessel_reference.exr");
-    let reference = quadray::output::read_render_exr(&path).unwrap().output;
+    let reference = quadray::jobs::output::read_render_exr(&path).unwrap().output;
     let what = "results/caustics/vessel_reference.exr (the passes at 2048 spp)";
     let c = common::equal_time("glass_vessel", "scenes/glass_vessel.toml", &scene, reference, what, 64);
     assert!(c.flip_fast < c.flip_brute, "FLIP {} not below brute force's {}", c.flip_fast, c.flip_brute);

@@ -8,9 +8,9 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
-use quadray::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::scene::{ConductorFresnel, Light, Material, MaterialKind, Scene};
 use quadray::passes::RenderOutput;
-use quadray::scene::{ConductorFresnel, Light, Material, MaterialKind, Scene};
 use quadray::vk::Context;
 
 const SLOPE_BAND: f64 = 0.08;

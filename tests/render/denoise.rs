@@ -1,4 +1,4 @@
-//! Denoising (Intel Open Image Denoise, src/denoise.rs), with the library
+//! Denoising (Intel Open Image Denoise, src/jobs/denoise.rs), with the library
 //! `make setup` installs: what it buys against more samples, and the
 //! features that guide it.
 //!
@@ -16,10 +16,10 @@
 //!   has the glass's own (white).
 
 use crate::common::*;
-use quadray::denoise::{denoise_output, DenoiseQuality, Denoiser};
-use quadray::metrics::{flip_mean, relative_mse};
+use quadray::jobs::denoise::{denoise_output, DenoiseQuality, Denoiser};
+use quadray::model::scene::Scene;
 use quadray::passes::RenderOutput;
-use quadray::scene::Scene;
+use quadray::tools::metrics::{flip_mean, relative_mse};
 
 fn denoiser() -> Denoiser {
     Denoiser::load().unwrap_or_else(|e| panic!("{e}"))
@@ -68,7 +68,7 @@ fn denoised_4_spp_beats_raw_64_spp(name: &str, scene: &Scene) {
 
 #[test]
 fn denoised_4_spp_beats_raw_64_spp_on_the_default_scene() {
-    let scene = quadray::scene::parse_scene(quadray::scene::DEFAULT_SCENE, "default").unwrap();
+    let scene = quadray::model::scene::parse_scene(quadray::model::scene::DEFAULT_SCENE, "default").unwrap();
     denoised_4_spp_beats_raw_64_spp("default scene", &scene);
 }
 

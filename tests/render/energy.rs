@@ -8,10 +8,10 @@
 
 use crate::common;
 
+use quadray::model::scene::{parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 use quadray::passes::outliers::{describe_path, largest_sample, luminance, outliers, SampleBound};
 use quadray::passes::{GpuScene, RenderOutput, RenderVariant, Renderer};
 use quadray::passes::{IntersectMode, LookupMode, SamplerMode, ShadingMode};
-use quadray::scene::{parse_scene, Scene, DEFAULT_SCENE, DEFAULT_SCENE_NAME};
 use quadray::vk::{Commands, Context};
 
 fn stress_scene() -> Scene {
@@ -28,6 +28,7 @@ const BRUTE_FORCE: RenderVariant = RenderVariant {
     lookup: LookupMode::Probes,
     sampler: SamplerMode::Sobol,
     backend: Some(quadray::vk::Backend::RayQuery),
+    kernel: None,
 };
 
 fn upload(ctx: &Context, cmds: &mut Commands, scene: &Scene) -> GpuScene {
@@ -132,7 +133,7 @@ fn the_largest_sample_aov_is_a_sample_the_recorder_reproduces() {
         let path = recorder.trace_path(&mut cmds, (x, y), m[1] as u32).unwrap();
         assert_eq!(path.left_out, 0);
         let end = path.events.last().expect("a recorded path");
-        assert_eq!(end.event, quadray::shader_interface::EVENT_END, "{}", describe_path(&scene, &path));
+        assert_eq!(end.event, quadray::gpu::shader_interface::EVENT_END, "{}", describe_path(&scene, &path));
         let got = luminance(end.radiance);
         assert!((got - m[0]).abs() <= 1e-5 * m[0].max(1.0), "pixel ({x}, {y}): recorded {got}, AOV {}", m[0]);
         checked += 1;
@@ -155,7 +156,7 @@ fn error_is_spread_over_the_image(name: &str, scene: &Scene, size: (u32, u32)) {
     let test = render(&ctx, scene, (size.0, size.1, 16));
     drop(ctx);
     common::assert_no_validation_errors(&counters);
-    let e = quadray::metrics::region_relative_mse(&reference, &test, 2, 64).unwrap();
+    let e = quadray::tools::metrics::region_relative_mse(&reference, &test, 2, 64).unwrap();
     let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
     for (object, pixels, error) in &e.regions {
         println!(

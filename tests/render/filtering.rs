@@ -13,9 +13,9 @@
 use crate::common;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
-use quadray::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::scene::{FilterMode, ImageSettings, Material, MaterialMaps, Scene, UvMapping, UvSettings};
 use quadray::passes::{RenderVariant, ShadingMode};
-use quadray::scene::{FilterMode, ImageSettings, Material, MaterialMaps, Scene, UvMapping, UvSettings};
 
 const A: f32 = 0.9;
 const B: f32 = 0.1;
@@ -40,7 +40,7 @@ fn ewa_over_ray_cones_averages_a_fine_checkerboard() {
     let mut m = Material::diffuse("checker", Vec3::ONE);
     m.maps = MaterialMaps { albedo: Some(0), ..Default::default() };
     scene.materials = vec![m];
-    scene.textures = vec![quadray::texture::checker(1024, CELLS, [A; 3], [B; 3])];
+    scene.textures = vec![quadray::model::texture::checker(1024, CELLS, [A; 3], [B; 3])];
     scene.camera.position = DVec3::new(0.0, 9.0, 9.0);
     scene.camera.look_at = DVec3::ZERO;
     scene.camera.vfov_degrees = 40.0;
@@ -134,7 +134,7 @@ fn filtering_adds_no_bias_without_textures() {
     drop(ctx);
     common::assert_no_validation_errors(&counters);
 
-    let flip = |o| quadray::metrics::flip_mean(&base, o, exposure).unwrap();
+    let flip = |o| quadray::tools::metrics::flip_mean(&base, o, exposure).unwrap();
     let (noise, f_cones, f_cov) = (flip(&none), flip(&cones), flip(&cov));
     println!(
         "FLIP against an independent none render (16 spp): none {noise:.4}, ray-cones {f_cones:.4}, covariance {f_cov:.4} (allowed ±{:.0}% of none's)",
@@ -191,9 +191,11 @@ fn footprints_through_a_curved_mirror_average_the_reflected_checker() {
     let mut scene = common::scene_with(objects);
     let mut m = Material::diffuse("checker", Vec3::ONE);
     m.maps = MaterialMaps { albedo: Some(0), ..Default::default() };
-    scene.materials =
-        vec![m, Material { kind: quadray::scene::MaterialKind::Mirror, ..Material::diffuse("mirror", Vec3::ONE) }];
-    scene.textures = vec![quadray::texture::checker(1024, MIRROR_CELLS, [A; 3], [B; 3])];
+    scene.materials = vec![
+        m,
+        Material { kind: quadray::model::scene::MaterialKind::Mirror, ..Material::diffuse("mirror", Vec3::ONE) },
+    ];
+    scene.textures = vec![quadray::model::texture::checker(1024, MIRROR_CELLS, [A; 3], [B; 3])];
     scene.camera.position = centre + DVec3::new(0.0, -0.1, 1.6);
     scene.camera.look_at = centre;
     scene.camera.vfov_degrees = 30.0;
@@ -238,9 +240,10 @@ fn footprints_through_a_curved_mirror_average_the_reflected_checker() {
         .collect();
     let contrast = (A - B) as f64;
     if let Ok(dir) = std::env::var("QUADRAY_TEST_IMAGES") {
-        quadray::output::write_png(&reference, 0.0, &std::path::Path::new(&dir).join("mirror-reference.png")).unwrap();
+        quadray::jobs::output::write_png(&reference, 0.0, &std::path::Path::new(&dir).join("mirror-reference.png"))
+            .unwrap();
         for (name, out) in &modes {
-            quadray::output::write_png(out, 0.0, &std::path::Path::new(&dir).join(format!("mirror-{name}.png")))
+            quadray::jobs::output::write_png(out, 0.0, &std::path::Path::new(&dir).join(format!("mirror-{name}.png")))
                 .unwrap();
         }
     }
@@ -312,7 +315,7 @@ fn filtered_albedo_through_a_glossy_reflector_converges_to_the_reference() {
             .iter()
             .zip(&reference)
             .zip(&reference_variance)
-            .map(|((t, r), v)| ((t - r).powi(2) - v) / (r * r + quadray::metrics::RELATIVE_MSE_EPSILON))
+            .map(|((t, r), v)| ((t - r).powi(2) - v) / (r * r + quadray::tools::metrics::RELATIVE_MSE_EPSILON))
             .sum();
         sum / img.len() as f64
     };

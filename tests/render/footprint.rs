@@ -1,6 +1,6 @@
-//! The covariance footprint (glsl/covariance.glsl, path_footprint.glsl) per
+//! The covariance footprint (glsl/lib/covariance.glsl, path_footprint.glsl) per
 //! bounce through curved mirrors and glossy lobes, against a brute-force
-//! footprint and against the f64 operators of `src/covariance.rs`.
+//! footprint and against the f64 operators of `src/model/covariance.rs`.
 //!
 //! The path recorder (`Renderer::trace_path`) gives, at each surface event
 //! of a covariance render, the footprint the texture lookups used: its
@@ -17,13 +17,13 @@
 use crate::common;
 
 use glam::{DMat2, DMat3, DQuat, DVec2, DVec3};
-use quadray::covariance::Covariance4;
-use quadray::geometry::reference;
+use quadray::gpu::shader_interface::EVENT_SURFACE;
+use quadray::model::covariance::Covariance4;
+use quadray::model::geometry::reference;
+use quadray::model::scene::{parse_scene, FilterMode, Scene};
 use quadray::passes::gpu::GpuPathVertex;
 use quadray::passes::variant::RenderVariant;
 use quadray::passes::{GpuScene, Renderer};
-use quadray::scene::{parse_scene, FilterMode, Scene};
-use quadray::shader_interface::EVENT_SURFACE;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -42,7 +42,7 @@ const NARROW: f64 = 0.1;
 /// (before the outgoing frame was made orthonormal, glossy samples off the
 /// plane of incidence were off by up to 0.70).
 const GPU_TOLERANCE: f64 = 0.05;
-/// The same for the f64 operators of `src/covariance.rs` on mirror paths
+/// The same for the f64 operators of `src/model/covariance.rs` on mirror paths
 /// (measured: at most 0.014; with the paper's curvature operator, which
 /// turns the direction by 2 instead of 2 cos θ across the plane of
 /// incidence, up to 0.73).
@@ -216,7 +216,7 @@ fn brute_force(scene: &Scene, path: &[(usize, DVec3, DMat2)], sigma: f64) -> (Ve
     (central, covs, followed as f64 / RAYS as f64)
 }
 
-/// The f64 operators of `src/covariance.rs` along a mirror path: the spatial
+/// The f64 operators of `src/model/covariance.rs` along a mirror path: the spatial
 /// footprint on each surface, in the basis of footprintBasis.
 fn f64_operators(scene: &Scene, central: &[Hit], sigma: f64) -> Vec<DMat2> {
     let eye = scene.camera.position;

@@ -18,9 +18,9 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
-use quadray::geometry::{FunctionalObject, Quadric};
+use quadray::model::geometry::{FunctionalObject, Quadric};
+use quadray::model::scene::Material;
 use quadray::passes::RenderOutput;
-use quadray::scene::Material;
 
 const MEAN_TOLERANCE: f64 = 0.005;
 const PIXEL_TOLERANCE: f64 = 0.1;
@@ -93,7 +93,7 @@ fn closed_furnace_converges_to_emission_over_one_minus_albedo() {
 /// scattering), by Monte Carlo over the CPU twin's visible-normal sampling:
 /// E = mean of the sample weights G2/G1.
 fn ggx_albedo(roughness: f64, cos_o: f64) -> f64 {
-    use quadray::sampling::{Conductor, FresnelModel};
+    use quadray::model::sampling::{Conductor, FresnelModel};
     let c = Conductor::new(roughness, FresnelModel::Schlick { f0: DVec3::ONE });
     let wo = DVec3::new((1.0 - cos_o * cos_o).max(0.0).sqrt(), 0.0, cos_o);
     let n = 200;
@@ -118,7 +118,7 @@ fn ggx_albedo(roughness: f64, cos_o: f64) -> f64 {
 /// range of θo (the silhouette) are skipped.
 #[test]
 fn ggx_conductor_loses_only_the_single_scattering_energy() {
-    use quadray::scene::{ConductorFresnel, MaterialKind};
+    use quadray::model::scene::{ConductorFresnel, MaterialKind};
     for roughness in [0.3f32, 0.7, 1.0] {
         let sphere =
             FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None };

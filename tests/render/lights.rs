@@ -21,10 +21,10 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
-use quadray::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::scene::{Light, Material, Scene};
 use quadray::passes::render::PIXEL_FILTER_REACH;
 use quadray::passes::{RenderVariant, SamplerMode};
-use quadray::scene::{Light, Material, Scene};
 
 const ALBEDO: f64 = 0.7;
 const BIAS_BOUND: f64 = 0.01;
@@ -304,8 +304,8 @@ fn uniform_environment() {
 /// computed by quadrature over the map's texels (piecewise constant).
 #[test]
 fn environment_map() {
-    use quadray::sampling::envmap::{procedural_sky, uv_to_direction, EnvironmentMap};
-    use quadray::scene::EnvironmentMapSettings;
+    use quadray::model::sampling::envmap::{procedural_sky, uv_to_direction, EnvironmentMap};
+    use quadray::model::scene::EnvironmentMapSettings;
     let sky = procedural_sky(128, 64);
     let map = EnvironmentMap::from_texture(&sky, 0.5);
     let (w, h) = (map.width as usize, map.height as usize);

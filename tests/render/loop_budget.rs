@@ -1,6 +1,6 @@
 //! lavapipe's loop limiter: Mesa 25.0's gallivm source gives one shader
 //! invocation 65,535 loop back-edges in all its loops, then silently leaves
-//! them (removed in 25.1). The loop-budget counter (glsl/loop_budget.glsl, a
+//! them (removed in 25.1). The loop-budget counter (glsl/intersection/loop_budget.glsl, a
 //! specialisation constant off in renders) counts every iteration of every
 //! loop of the tracing code per invocation.
 //!
@@ -17,10 +17,10 @@
 //! passes). docs/stability.md, "Loop budget", records the figures and what
 //! the count leaves out (lavapipe's own BVH walk).
 
+use quadray::gpu::shader_interface::SPEC_LOOP_BUDGET;
+use quadray::model::scene::Scene;
 use quadray::passes::gpu::LoopBudgetPush;
 use quadray::passes::{GpuScene, LoopBudget, RenderVariant, Renderer, LOOP_LIMIT};
-use quadray::scene::Scene;
-use quadray::shader_interface::SPEC_LOOP_BUDGET;
 use quadray::vk::{Backend, ComputePipeline};
 
 use crate::common;
@@ -52,7 +52,7 @@ fn the_counter_counts_every_iteration_and_the_driver_is_asked_for_its_limit() {
     let mut gpu = GpuScene::for_render(&ctx.device, &mut cmds, &scene).unwrap();
     gpu.measure_loop_budget(true);
     let pipeline =
-        ComputePipeline::new(&ctx.device, &quadray::shaders::loop_budget(), &[(SPEC_LOOP_BUDGET, 1)]).unwrap();
+        ComputePipeline::new(&ctx.device, &quadray::gpu::shaders::loop_budget(), &[(SPEC_LOOP_BUDGET, 1)]).unwrap();
     pipeline.bind(&gpu.geometry_bindings()).unwrap();
     let mut rows = Vec::new();
     for spend in [0, 1000, 70_000] {
@@ -116,7 +116,7 @@ radiance = [20, 20, 20]
         radius = 1.2 * bump,
         fov = (8.0 / distance).to_degrees().clamp(1e-4, 60.0),
     );
-    quadray::scene::parse_scene(&text, "limb.toml").unwrap()
+    quadray::model::scene::parse_scene(&text, "limb.toml").unwrap()
 }
 
 #[test]
@@ -126,9 +126,9 @@ fn no_tracing_invocation_uses_half_the_loop_budget() {
         cases.push((format!("{count} bumps across the limb"), limb_scene(count, 4.0, 2), Backend::RayQuery));
     }
     let mut glass = common::project_scene("tests/energy_stress.toml");
-    common::set_image(&mut glass, (24, 16), 1, quadray::scene::MAX_DEPTH);
+    common::set_image(&mut glass, (24, 16), 1, quadray::model::scene::MAX_DEPTH);
     cases.push((
-        format!("energy_stress (glass, metal) at depth {}", quadray::scene::MAX_DEPTH),
+        format!("energy_stress (glass, metal) at depth {}", quadray::model::scene::MAX_DEPTH),
         glass,
         Backend::RayQuery,
     ));

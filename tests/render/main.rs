@@ -14,6 +14,7 @@ mod energy;
 mod filtering;
 mod footprint;
 mod furnace;
+mod kernels;
 mod lights;
 mod loop_budget;
 mod media;

@@ -13,8 +13,8 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
-use quadray::geometry::{FunctionalObject, Quadric};
-use quadray::scene::{Light, Material, Medium};
+use quadray::model::geometry::{FunctionalObject, Quadric};
+use quadray::model::scene::{Light, Material, Medium};
 
 /// Image mean within this of the expected mean.
 const MEAN_TOLERANCE: f64 = 0.005;
@@ -41,7 +41,7 @@ fn light_box(h: f64, radiance: f32) -> Vec<Light> {
     ]
 }
 
-fn ball(radius: f64, at: DVec3) -> quadray::scene::SceneObject {
+fn ball(radius: f64, at: DVec3) -> quadray::model::scene::SceneObject {
     let shape = FunctionalObject {
         base: Quadric::ellipsoid(DVec3::ZERO, DVec3::splat(radius)),
         perturbations: vec![],

@@ -11,9 +11,9 @@
 use crate::common;
 
 use glam::{DAffine3, DVec3, Vec3};
-use quadray::geometry::{FunctionalObject, Quadric};
+use quadray::model::geometry::{FunctionalObject, Quadric};
+use quadray::model::scene::{Light, Material, MaterialKind, Scene};
 use quadray::passes::RenderOutput;
-use quadray::scene::{Light, Material, MaterialKind, Scene};
 
 const NOISE_RATIO: f64 = 1.15;
 
@@ -30,7 +30,7 @@ fn scene(inner: bool) -> Scene {
     let floor = FunctionalObject {
         base: Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
         perturbations: vec![],
-        clip: Some(quadray::geometry::Aabb::new(DVec3::new(-5.0, -0.5, -5.0), DVec3::new(5.0, 0.5, 5.0))),
+        clip: Some(quadray::model::geometry::Aabb::new(DVec3::new(-5.0, -0.5, -5.0), DVec3::new(5.0, 0.5, 5.0))),
     };
     let mut objects = vec![
         common::object("outer", ball(1.0), DAffine3::from_translation(DVec3::new(0.0, 1.0, 0.0))),
@@ -42,7 +42,7 @@ fn scene(inner: bool) -> Scene {
     let mut s = common::scene_with(objects);
     s.materials = vec![
         glass("glass", 1.5),
-        quadray::scene::Material::diffuse("floor", Vec3::splat(0.6)),
+        quadray::model::scene::Material::diffuse("floor", Vec3::splat(0.6)),
         glass("other glass of the same index", 1.5),
     ];
     s.objects[1].material = 1;

@@ -20,7 +20,7 @@
 //! checked by this layer. `docs/stability.md`, "Synchronisation".
 
 use glam::DVec3;
-use quadray::geometry::CellParams;
+use quadray::model::geometry::CellParams;
 use quadray::passes::gpu::GpuRay;
 use quadray::passes::{GpuScene, IntersectMode, ProbePass};
 use quadray::vk::{Access, Backend, ShaderStage};

@@ -1,4 +1,4 @@
-//! The shader's texture filters (glsl/texfilter.glsl) on footprints given
+//! The shader's texture filters (glsl/lib/texfilter.glsl) on footprints given
 //! directly, against analytic answers:
 //!
 //! - EWA (the reference lookup) and the trilinear probes (the default) over
@@ -13,13 +13,13 @@
 use crate::common;
 
 use glam::{DVec2, DVec3, Vec3};
-use quadray::geometry::{FunctionalObject, Quadric};
+use quadray::model::geometry::{FunctionalObject, Quadric};
+use quadray::model::scene::{Material, MaterialMaps};
 use quadray::passes::gpu::{GpuTexQuery, GpuTexResult};
 use quadray::passes::{GpuScene, TexProbePass};
-use quadray::scene::{Material, MaterialMaps};
 
+use quadray::model::texture::{bump_heights, checker, lean, normals_from_heights, TextureImage};
 use quadray::passes::LookupMode;
-use quadray::texture::{bump_heights, checker, lean, normals_from_heights, TextureImage};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -102,7 +102,7 @@ fn exact_average(uv: DVec2, a1: DVec2, a2: DVec2) -> f64 {
 }
 
 /// A scene that holds the given textures (the object is never traced).
-fn texture_scene(textures: Vec<TextureImage>, maps: MaterialMaps) -> quadray::scene::Scene {
+fn texture_scene(textures: Vec<TextureImage>, maps: MaterialMaps) -> quadray::model::scene::Scene {
     let sphere =
         FunctionalObject { base: Quadric::ellipsoid(DVec3::ZERO, DVec3::ONE), perturbations: vec![], clip: None };
     let mut scene = common::scene_with(vec![common::object("sphere", sphere, glam::DAffine3::IDENTITY)]);
@@ -125,7 +125,7 @@ fn query(texture: u32, uv: DVec2, a1: DVec2, a2: DVec2, alpha: f32) -> GpuTexQue
 }
 
 /// Runs `queries` on the textures of `scene` with `lookup` (validation on).
-fn run_lookups(scene: &quadray::scene::Scene, queries: &[GpuTexQuery], lookup: LookupMode) -> Vec<GpuTexResult> {
+fn run_lookups(scene: &quadray::model::scene::Scene, queries: &[GpuTexQuery], lookup: LookupMode) -> Vec<GpuTexResult> {
     let (ctx, counters, mut cmds) = common::gpu();
     let gpu = GpuScene::new(&ctx.device, &mut cmds, scene, &Default::default()).unwrap();
     let results = TexProbePass::with_lookup(&ctx.device, &gpu, queries, lookup).unwrap().run(&mut cmds).unwrap();

@@ -10,9 +10,9 @@
 use crate::common;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
-use quadray::geometry::uv::object_uv;
-use quadray::geometry::{Aabb, FunctionalObject, Quadric};
-use quadray::scene::{Material, MaterialMaps, UvMapping, UvSettings};
+use quadray::model::geometry::uv::object_uv;
+use quadray::model::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::scene::{Material, MaterialMaps, UvMapping, UvSettings};
 
 const BORDER: f64 = 0.05;
 const CELLS: u32 = 8;
@@ -68,7 +68,7 @@ fn colour_maps_follow_the_uv_mappings() {
     let mut m = Material::diffuse("checker", Vec3::ONE);
     m.maps = MaterialMaps { albedo: Some(0), ..Default::default() };
     scene.materials = vec![m];
-    scene.textures = vec![quadray::texture::checker(256, CELLS, A, B)];
+    scene.textures = vec![quadray::model::texture::checker(256, CELLS, A, B)];
     scene.camera.position = DVec3::new(0.0, 3.0, 6.0);
     scene.camera.look_at = DVec3::new(0.0, 0.6, 0.0);
     scene.image.width = 96;
@@ -92,7 +92,9 @@ fn colour_maps_follow_the_uv_mappings() {
             let dir = (forward + nx * right + ny * up).normalize();
             let p = eye + a.depth as f64 * dir;
             let Some(obj) = scene.objects.iter().min_by(|o1, o2| {
-                let f = |o: &quadray::scene::SceneObject| o.shape.eval(o.transform.inverse().transform_point3(p)).abs();
+                let f = |o: &quadray::model::scene::SceneObject| {
+                    o.shape.eval(o.transform.inverse().transform_point3(p)).abs()
+                };
                 f(o1).total_cmp(&f(o2))
             }) else {
                 continue;

@@ -14,7 +14,7 @@
 
 use crate::common;
 
-use quadray::scene::parse_scene;
+use quadray::model::scene::parse_scene;
 
 /// Image mean within this of 1 (dielectric furnace).
 const FURNACE_MEAN_TOLERANCE: f64 = 0.005;

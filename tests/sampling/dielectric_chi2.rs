@@ -1,4 +1,4 @@
-//! Tests of the rough dielectric (`quadray::sampling::bsdf::RoughDielectric`,
+//! Tests of the rough dielectric (`quadray::model::sampling::bsdf::RoughDielectric`,
 //! Walter et al. 2007 with visible-normal sampling): chi-square tests of its
 //! sampler against its density over the whole sphere of directions (both
 //! hemispheres: reflection and refraction, from outside and from inside),
@@ -15,10 +15,10 @@
 use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
-use quadray::sampling::bsdf::RoughDielectric;
-use quadray::sampling::chi2::{self, chi2_test, Chi2Config, Pcg32};
-use quadray::sampling::*;
-use quadray::scene::{Material, MaterialKind};
+use quadray::model::sampling::bsdf::RoughDielectric;
+use quadray::model::sampling::chi2::{self, chi2_test, Chi2Config, Pcg32};
+use quadray::model::sampling::*;
+use quadray::model::scene::{Material, MaterialKind};
 
 /// GGX α of the chi-square tests.
 const ALPHAS: [f64; 3] = [0.1, 0.3, 0.7];

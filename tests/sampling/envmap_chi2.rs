@@ -1,4 +1,4 @@
-//! Tests of the environment-map importance sampling (`quadray::sampling::envmap`):
+//! Tests of the environment-map importance sampling (`quadray::model::sampling::envmap`):
 //! chi-square tests of `EnvironmentMap::sample` against `EnvironmentMap::pdf`
 //! (see `sampling::chi2`) for a procedural sky, a random map and a map that
 //! is black but for one texel; the normalisation of the density; the
@@ -17,9 +17,9 @@
 use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
-use quadray::sampling::chi2::{self, chi2_test, Chi2Config, Chi2Report, Pcg32};
-use quadray::sampling::envmap::{importance_weights, luminance, sky_sun_direction};
-use quadray::sampling::{direction_to_uv, procedural_sky, uv_to_direction, EnvironmentMap};
+use quadray::model::sampling::chi2::{self, chi2_test, Chi2Config, Chi2Report, Pcg32};
+use quadray::model::sampling::envmap::{importance_weights, luminance, sky_sun_direction};
+use quadray::model::sampling::{direction_to_uv, procedural_sky, uv_to_direction, EnvironmentMap};
 
 /// Chi-square tests run by this file (the Šidák correction divides the
 /// family-wise level among them): sky 2 (whole sphere, cap on the sun),
@@ -215,7 +215,7 @@ fn chi2_rejects_wrong_densities() {
 #[test]
 fn pdf_integrates_to_one() {
     let pole = axis(2);
-    let (tu, tv) = quadray::sampling::frame_around(pole);
+    let (tu, tv) = quadray::model::sampling::frame_around(pole);
     let (nc, np) = (16, 32);
     for (name, map) in [("sky 64x32", sky()), ("random 16x8", random_map()), ("single texel 16x8", single_texel_map())]
     {
@@ -332,7 +332,7 @@ fn uv_round_trip() {
     }
     let mut rng = Pcg32::new(5, 9);
     for _ in 0..10_000 {
-        let d = quadray::sampling::sample_uniform_sphere(rng.next_f64(), rng.next_f64());
+        let d = quadray::model::sampling::sample_uniform_sphere(rng.next_f64(), rng.next_f64());
         let uv = direction_to_uv(d);
         assert!((0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y));
         assert!((uv_to_direction(uv.x, uv.y) - d).length() < 1e-12);

@@ -1,5 +1,5 @@
 //! Chi-square tests of the Henyey–Greenstein sampler (`sampling::phase`, the
-//! CPU twin of `glsl/media.glsl`) against its density, for isotropic,
+//! CPU twin of `glsl/lib/media.glsl`) against its density, for isotropic,
 //! forward, strongly forward and backward scattering, with travel
 //! directions off the binning axis (`sampling::chi2` bins the whole sphere);
 //! likewise the halo sampler and the mixture of a path's first scattering
@@ -9,8 +9,10 @@
 //! differs from the fraction of valid samples by more than 1e-2.
 
 use glam::DVec3;
-use quadray::sampling::chi2::{self, chi2_test, Chi2Config};
-use quadray::sampling::phase::{halo_pdf, hg_pdf, sample_halo, sample_hg, sample_scatter, scatter_pdf, HALO_SHARE};
+use quadray::model::sampling::chi2::{self, chi2_test, Chi2Config};
+use quadray::model::sampling::phase::{
+    halo_pdf, hg_pdf, sample_halo, sample_hg, sample_scatter, scatter_pdf, HALO_SHARE,
+};
 
 /// Tests in this file: 5 values of g, the halo, and 3 mixtures.
 const CHI2_TESTS: usize = 9;

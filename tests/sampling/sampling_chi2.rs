@@ -1,4 +1,4 @@
-//! Tests of the CPU sampling twins (`quadray::sampling`): chi-square tests of
+//! Tests of the CPU sampling twins (`quadray::model::sampling`): chi-square tests of
 //! every non-delta sampler against its density (Mitsuba-style, see
 //! `sampling::chi2`), exact checks of the delta lobes, Fresnel identities, and
 //! GGX normalisation and white-furnace albedo.
@@ -13,8 +13,8 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use quadray::sampling::chi2::{self, chi2_test, Chi2Config, Pcg32};
-use quadray::sampling::*;
+use quadray::model::sampling::chi2::{self, chi2_test, Chi2Config, Pcg32};
+use quadray::model::sampling::*;
 
 /// Chi-square tests run by this file (the Šidák correction divides the
 /// family-wise level among them): cosine hemisphere 1, uniform sphere 1,

@@ -1,5 +1,5 @@
-//! The GLSL sampling routines (glsl/bsdf.glsl, glsl/lights.glsl, run by
-//! glsl/twins.comp) against their f64 CPU twins (src/sampling/), which the
+//! The GLSL sampling routines (glsl/lib/bsdf.glsl, glsl/lib/lights.glsl, run by
+//! glsl/testing/twins.comp) against their f64 CPU twins (src/model/sampling/), which the
 //! chi-square tests (tests/sampling/sampling_chi2.rs) check against their pdfs. Same
 //! inputs on both sides; the outputs must agree within f32 precision:
 //! directions within `DIR_TOL`, weights, radiance and densities within
@@ -16,9 +16,9 @@
 use crate::common;
 
 use glam::{DVec3, Vec3};
+use quadray::model::sampling::{self, Bsdf};
+use quadray::model::scene::{ConductorFresnel, Light, Material, MaterialKind};
 use quadray::passes::gpu::{GpuLight, GpuMaterial, TwinCase, TwinPush, TwinResult};
-use quadray::sampling::{self, Bsdf};
-use quadray::scene::{ConductorFresnel, Light, Material, MaterialKind};
 use quadray::vk::{vk, Binding, Buffer, Commands, ComputePipeline, MemoryLocation};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -36,7 +36,7 @@ const VNDF_RIM: f64 = 1e-3;
 /// checks them in every shader.
 #[test]
 fn twin_structs_match_the_shader() {
-    let iface = quadray::vk::reflect::ShaderInterface::reflect(&quadray::shaders::twins()).unwrap();
+    let iface = quadray::vk::reflect::ShaderInterface::reflect(&quadray::gpu::shaders::twins()).unwrap();
     let layouts = quadray::passes::gpu::host_layouts();
     let twins: Vec<_> = layouts.iter().filter(|l| l.glsl.starts_with("Twin")).collect();
     assert_eq!(twins.len(), 3);
@@ -59,7 +59,7 @@ fn run_twins_with(cases: &[TwinCase], env: Option<TwinEnvironment<'_>>) -> Vec<T
     let counters = ctx.counters();
     let results = {
         let device = &ctx.device;
-        let pipeline = ComputePipeline::new(device, &quadray::shaders::twins(), &[]).unwrap();
+        let pipeline = ComputePipeline::new(device, &quadray::gpu::shaders::twins(), &[]).unwrap();
         let input = Buffer::with_data(device, "twin cases", cases, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
         let output = Buffer::storage(
             device,
@@ -72,7 +72,7 @@ fn run_twins_with(cases: &[TwinCase], env: Option<TwinEnvironment<'_>>) -> Vec<T
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let table = Buffer::with_data(device, "environment table", table, usage).unwrap();
         let texels = Buffer::with_data(device, "environment texels", texels, usage).unwrap();
-        use quadray::shader_interface::*;
+        use quadray::gpu::shader_interface::*;
         pipeline
             .bind(&[
                 (BINDING_TWIN_CASES, Binding::Buffer(&input)),
@@ -481,7 +481,7 @@ fn gpu_light_sampling_matches_the_cpu_twin() {
 
 #[test]
 fn gpu_environment_map_sampling_matches_the_cpu_twin() {
-    use quadray::sampling::envmap::{procedural_sky, EnvironmentMap};
+    use quadray::model::sampling::envmap::{procedural_sky, EnvironmentMap};
     let sky = procedural_sky(64, 32);
     let map = EnvironmentMap::from_texture(&sky, 0.5);
     let table = map.cdf_buffer();
@@ -508,7 +508,7 @@ fn gpu_environment_map_sampling_matches_the_cpu_twin() {
         let wi = d3(c.wi).normalize();
         // Densities at given directions: a direction within 1e-4 texel of a
         // texel border may fall in either texel in f32.
-        let uv = quadray::sampling::envmap::direction_to_uv(wi);
+        let uv = quadray::model::sampling::envmap::direction_to_uv(wi);
         let border = |x: f64, n: u32| ((x * n as f64) - (x * n as f64).round()).abs() < 1e-4;
         if border(uv.x, map.width) || border(uv.y, map.height) {
             edge += 1;
@@ -553,12 +553,12 @@ fn gpu_environment_map_sampling_matches_the_cpu_twin() {
     assert!(share <= MAX_EDGE_SHARE, "too many border cases: {share}");
 }
 
-/// The path tracer's Owen-scrambled Sobol samples (glsl/sobol.glsl) equal
-/// their CPU twin (quadray::sampling::sobol) to the bit, for pixel seeds,
+/// The path tracer's Owen-scrambled Sobol samples (glsl/lib/sobol.glsl) equal
+/// their CPU twin (quadray::model::sampling::sobol) to the bit, for pixel seeds,
 /// sample indices and decisions over their ranges.
 #[test]
 fn gpu_sobol_samples_match_the_cpu_twin_to_the_bit() {
-    use quadray::sampling::sobol;
+    use quadray::model::sampling::sobol;
     let mut rng = Pcg64::seed_from_u64(28);
     let mut cases = Vec::new();
     while cases.len() < 20_000 {
@@ -601,7 +601,7 @@ fn gpu_sobol_samples_match_the_cpu_twin_to_the_bit() {
 
 #[test]
 fn gpu_halo_sampling_matches_the_cpu_twin() {
-    use quadray::sampling::phase::{halo_pdf, sample_halo};
+    use quadray::model::sampling::phase::{halo_pdf, sample_halo};
     // The GPU builds its frame around the axis differently from glam's
     // orthonormal pair, so a sample is compared by its angle to the axis
     // (which carries the density; φ is uniform in both) and by the density

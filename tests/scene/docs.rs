@@ -216,7 +216,7 @@ fn the_commands_and_flags_the_docs_name_exist() {
 fn the_readme_scene_file_parses() {
     let text = std::fs::read_to_string(root().join("README.md")).unwrap();
     let block = text.split("```toml").nth(1).expect("a TOML block in the README").split("```").next().unwrap();
-    quadray::scene::parse_scene(block, "README.md").unwrap_or_else(|e| panic!("the README's scene file: {e}"));
+    quadray::model::scene::parse_scene(block, "README.md").unwrap_or_else(|e| panic!("the README's scene file: {e}"));
 }
 
 #[test]

@@ -1,11 +1,19 @@
-//! The library's modules form layers (docs/architecture.md): no module uses
-//! one that uses it back, directly or through others. Read from the source:
-//! every `crate::a::b` and `super::a` path in code (comments left out) is an
-//! edge from the file's module to the module it names. Checked at two
-//! levels: between the top-level modules of `src/` (the crate root, which
-//! holds the error types every layer returns, left out), and between the
-//! children of every folder module (files such as `passes/render.rs` and
-//! `passes/checkpoint.rs`).
+//! The library's modules form layers (docs/architecture.md, "Layers"): no
+//! module uses one that uses it back, directly or through others, and no
+//! module uses a layer above its own. Read from the source: every
+//! `crate::` and `super::` path in code (comments and unit-test modules
+//! left out), grouped
+//! imports (`use super::{a::B, c::{d, e}}`) expanded, and names a folder's
+//! `mod.rs` re-exports (`pub use sync::Access`) followed to the file that
+//! defines them, is an edge from the file's module to the module it names.
+//! Cycles are checked at two levels: between the top-level modules of
+//! `src/` (the crate root, which holds the error types every layer returns,
+//! left out), and between the children of every folder module. The order is
+//! checked between top-level modules against the table of
+//! docs/architecture.md, read from the page itself: a module may use its
+//! own layer's modules and those of the rows above it. The check is shown
+//! to see faults by injecting two into a copy of the source: a cycle inside
+//! `src/vk` through a grouped import, and a core module using a tool.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -34,36 +42,160 @@ fn module_of(relative: &Path) -> Vec<String> {
     parts
 }
 
-/// The identifiers of the path that starts at byte `start` of `line`:
-/// `crate::passes::gpu::GpuAov` gives `["passes", "gpu", "GpuAov"]`.
-fn path_at(line: &str, start: usize) -> Vec<String> {
-    let rest = &line[start..];
-    let end = rest.find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).unwrap_or(rest.len());
-    rest[..end].split("::").filter(|s| !s.is_empty()).map(str::to_string).collect()
+/// The file's code without its comments (line comments; doc comments are
+/// line comments too) and without its unit tests: everything from the
+/// `#[cfg(test)]` line of a `mod` on (the test module, which by the
+/// project's convention closes the file), whose imports are test-only
+/// edges.
+fn code_of(text: &str) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let end = (0..lines.len())
+        .find(|&i| lines[i].trim() == "#[cfg(test)]" && lines.get(i + 1).is_some_and(|l| l.starts_with("mod ")))
+        .unwrap_or(lines.len());
+    lines[..end].iter().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n")
 }
 
-/// The modules a file names: `crate::` paths as they are, `super::` paths
-/// resolved against the file's module (`self` paths stay inside it).
-fn referenced_modules(module: &[String], text: &str) -> Vec<Vec<String>> {
+fn is_ident(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_'
+}
+
+/// The paths of the use tree (or plain path) at byte `*i` of `s`, each as
+/// its identifiers: `a::{b, c::{d, e as f}, self}` gives `[a, b]`,
+/// `[a, c, d]`, `[a, c, e]` and `[a]`. Stops where the tree ends.
+fn use_tree(s: &[u8], i: &mut usize) -> Vec<Vec<String>> {
+    let skip_ws = |i: &mut usize| {
+        while *i < s.len() && s[*i].is_ascii_whitespace() {
+            *i += 1;
+        }
+    };
+    skip_ws(i);
+    if *i < s.len() && s[*i] == b'{' {
+        *i += 1;
+        let mut out = Vec::new();
+        loop {
+            skip_ws(i);
+            if *i >= s.len() {
+                return out;
+            }
+            if s[*i] == b'}' {
+                *i += 1;
+                return out;
+            }
+            out.extend(use_tree(s, i));
+            skip_ws(i);
+            if *i < s.len() && s[*i] == b',' {
+                *i += 1;
+            } else if *i < s.len() && s[*i] != b'}' {
+                // Not a use tree after all (a struct literal, a block).
+                return out;
+            }
+        }
+    }
+    let start = *i;
+    while *i < s.len() && (is_ident(s[*i]) || s[*i] == b'*') {
+        *i += 1;
+    }
+    let segment = String::from_utf8_lossy(&s[start..*i]).into_owned();
+    if segment.is_empty() {
+        return Vec::new();
+    }
+    if s[*i..].starts_with(b"::") {
+        *i += 2;
+        let rest = use_tree(s, i);
+        let mut out: Vec<Vec<String>> = rest
+            .into_iter()
+            .map(|mut p| {
+                p.insert(0, segment.clone());
+                p
+            })
+            .collect();
+        if out.is_empty() {
+            out.push(vec![segment]);
+        }
+        return out;
+    }
+    // `name as alias`: the alias is what the file uses; the path is `name`.
+    let mut j = *i;
+    while j < s.len() && s[j].is_ascii_whitespace() {
+        j += 1;
+    }
+    if s[j..].starts_with(b"as") && s.get(j + 2).is_some_and(|c| c.is_ascii_whitespace()) {
+        j += 2;
+        while j < s.len() && s[j].is_ascii_whitespace() {
+            j += 1;
+        }
+        while j < s.len() && is_ident(s[j]) {
+            j += 1;
+        }
+        *i = j;
+    }
+    // `self` names the path so far; `*` and other names are items.
+    if segment == "self" {
+        return vec![vec![]];
+    }
+    vec![vec![segment]]
+}
+
+/// The paths a file names from the crate root: `crate::` paths as they
+/// are, `super::` (and `super::super::`) paths resolved against the file's
+/// module, grouped imports expanded.
+fn referenced_paths(module: &[String], code: &str) -> Vec<Vec<String>> {
+    let s = code.as_bytes();
     let mut out = Vec::new();
-    for line in text.lines() {
-        let code = line.split("//").next().unwrap();
-        // `super` is the parent of the file's module (a folder's mod.rs is
-        // the folder's module).
-        let parent = module[..module.len().saturating_sub(1)].to_vec();
-        for (prefix, base) in [("crate::", Vec::new()), ("super::", parent)] {
-            let mut from = 0;
-            while let Some(i) = code[from..].find(prefix) {
-                let at = from + i;
-                from = at + prefix.len();
-                // `super::super::x` and `crate::` within a longer word.
-                let before = code[..at].chars().last();
-                if before.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':') {
-                    continue;
+    let mut i = 0;
+    while i < s.len() {
+        let rest = &s[i..];
+        let boundary = i == 0 || !(is_ident(s[i - 1]) || s[i - 1] == b':');
+        if boundary && rest.starts_with(b"crate::") {
+            let mut j = i + "crate::".len();
+            out.extend(use_tree(s, &mut j));
+            i = j.max(i + 1);
+        } else if boundary && rest.starts_with(b"super::") {
+            // `super` is the parent of the file's module (a folder's mod.rs
+            // is the folder's module), once per `super::`.
+            let mut base = module.to_vec();
+            let mut j = i;
+            while s[j..].starts_with(b"super::") {
+                base.pop();
+                j += "super::".len();
+            }
+            for p in use_tree(s, &mut j) {
+                let mut full = base.clone();
+                full.extend(p);
+                out.push(full);
+            }
+            i = j.max(i + 1);
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// What each folder module re-exports from its children: the names of
+/// `pub use child::{A, B as C}` in its `mod.rs` (or `lib.rs`), by folder
+/// and name, to the child that defines them.
+fn re_exports(
+    src: &Path,
+    files: &[PathBuf],
+    modules: &BTreeSet<Vec<String>>,
+) -> BTreeMap<(Vec<String>, String), String> {
+    let mut out = BTreeMap::new();
+    for file in files {
+        let module = module_of(file.strip_prefix(src).unwrap());
+        let code = code_of(&std::fs::read_to_string(file).unwrap());
+        let s = code.as_bytes();
+        let mut from = 0;
+        while let Some(k) = code[from..].find("pub use ") {
+            let mut j = from + k + "pub use ".len();
+            from = j;
+            for path in use_tree(s, &mut j) {
+                let (Some(child), Some(last)) = (path.first(), path.last()) else { continue };
+                let mut child_module = module.clone();
+                child_module.push(child.clone());
+                if path.len() >= 2 && modules.contains(&child_module) {
+                    out.insert((module.clone(), last.clone()), child.clone());
                 }
-                let mut path = base.clone();
-                path.extend(path_at(code, from));
-                out.push(path);
             }
         }
     }
@@ -111,36 +243,73 @@ fn find_cycle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>>
     None
 }
 
-#[test]
-fn modules_form_layers_without_cycles() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+/// The layers of docs/architecture.md's table, bottom first: each row's
+/// top-level modules (`src/NAME.rs` or `src/NAME/` in its "where" column).
+fn documented_layers(page: &str) -> Vec<(String, BTreeSet<String>)> {
+    let table = page.split("## Layers").nth(1).expect("a Layers section").split("\n## ").next().unwrap();
+    let mut layers = Vec::new();
+    for row in table.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| layer")) {
+        let cells: Vec<&str> = row.split(" | ").collect();
+        let (Some(name), Some(place)) = (cells.first(), cells.get(1)) else { continue };
+        let modules: BTreeSet<String> = place
+            .split('`')
+            .skip(1)
+            .step_by(2)
+            .filter_map(|p| p.strip_prefix("src/"))
+            .filter_map(|p| p.split('/').next())
+            .map(|m| m.trim_end_matches(".rs").to_string())
+            .filter(|m| !m.is_empty() && !m.contains('.'))
+            .collect();
+        if !modules.is_empty() {
+            layers.push((name.trim_start_matches("| ").to_string(), modules));
+        }
+    }
+    layers
+}
+
+/// What the check found: modules, edges between siblings, edges between
+/// layers.
+struct Layering {
+    modules: usize,
+    sibling_edges: usize,
+    layer_edges: usize,
+}
+
+/// Checks the sources under `src` against `page` (docs/architecture.md):
+/// cycles at every level, and the layer order at the top. Errors say what
+/// is wrong, one line each.
+fn check(src: &Path, page: &str) -> Result<Layering, Vec<String>> {
     let mut files = Vec::new();
-    rust_files(&src, &mut files);
+    rust_files(src, &mut files);
     // Every module of the crate, to tell module names from items in paths.
     let modules: BTreeSet<Vec<String>> =
-        files.iter().map(|f| module_of(f.strip_prefix(&src).unwrap())).filter(|m| !m.is_empty()).collect();
-    // Edges between the modules two paths' longest module prefixes name.
+        files.iter().map(|f| module_of(f.strip_prefix(src).unwrap())).filter(|m| !m.is_empty()).collect();
+    let exports = re_exports(src, &files, &modules);
+    // Edges between the modules two paths' longest module prefixes name
+    // (through a folder's re-export to the child that defines the name).
     let mut edges: BTreeSet<(Vec<String>, Vec<String>)> = BTreeSet::new();
     for file in &files {
-        let relative = file.strip_prefix(&src).unwrap();
-        let module = module_of(relative);
+        let module = module_of(file.strip_prefix(src).unwrap());
         // main.rs is the binary (it uses the library by name); the root
         // (lib.rs) holds the shared error types.
         if module.is_empty() {
             continue;
         }
-        let text = std::fs::read_to_string(file).unwrap();
-        for path in referenced_modules(&module, &text) {
-            let target = (1..=path.len()).rev().map(|n| path[..n].to_vec()).find(|p| modules.contains(p));
-            if let Some(target) = target {
-                edges.insert((module.clone(), target));
+        let code = code_of(&std::fs::read_to_string(file).unwrap());
+        for path in referenced_paths(&module, &code) {
+            let Some(n) = (1..=path.len()).rev().find(|&n| modules.contains(&path[..n])) else { continue };
+            let mut target = path[..n].to_vec();
+            if let Some(child) = path.get(n).and_then(|item| exports.get(&(target.clone(), item.clone()))) {
+                target.push(child.clone());
             }
+            edges.insert((module.clone(), target));
         }
     }
-    // The top level, then the children of every folder module.
+    let mut errors = Vec::new();
+    // Cycles: the top level, then the children of every folder module.
     let mut levels: Vec<Vec<String>> = vec![vec![]];
     levels.extend(modules.iter().filter(|m| modules.iter().any(|c| c.len() > m.len() && c.starts_with(m))).cloned());
-    let mut checked = 0;
+    let mut sibling_edges = 0;
     for parent in &levels {
         let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
         let depth = parent.len();
@@ -152,12 +321,128 @@ fn modules_form_layers_without_cycles() {
                 }
             }
         }
-        checked += graph.values().map(BTreeSet::len).sum::<usize>();
+        sibling_edges += graph.values().map(BTreeSet::len).sum::<usize>();
         if let Some(cycle) = find_cycle(&graph) {
             let within = if parent.is_empty() { "the crate".to_string() } else { parent.join("::") };
-            panic!("a module cycle within {within}: {}", cycle.join(" -> "));
+            errors.push(format!("a module cycle within {within}: {}", cycle.join(" -> ")));
         }
     }
-    println!("{} modules, {} edges between siblings, no cycle", modules.len(), checked);
-    assert!(checked > 50, "too few edges were read ({checked}): is the source where the test looks?");
+    // The layer order between top-level modules.
+    let layers = documented_layers(page);
+    let rank: BTreeMap<&str, usize> =
+        layers.iter().enumerate().flat_map(|(r, (_, ms))| ms.iter().map(move |m| (m.as_str(), r))).collect();
+    let top: BTreeSet<&str> = modules.iter().map(|m| m[0].as_str()).collect();
+    for m in &top {
+        if !rank.contains_key(m) {
+            errors.push(format!("module `{m}` is in no layer of docs/architecture.md's table"));
+        }
+    }
+    let mut layer_edges = 0;
+    for (from, to) in &edges {
+        let (a, b) = (from[0].as_str(), to[0].as_str());
+        if a == b {
+            continue;
+        }
+        let (Some(&ra), Some(&rb)) = (rank.get(a), rank.get(b)) else { continue };
+        layer_edges += 1;
+        if rb > ra {
+            errors.push(format!(
+                "`{}` ({}) uses `{}` ({}), a layer above it",
+                from.join("::"),
+                layers[ra].0,
+                to.join("::"),
+                layers[rb].0
+            ));
+        }
+    }
+    if errors.is_empty() {
+        Ok(Layering { modules: modules.len(), sibling_edges, layer_edges })
+    } else {
+        Err(errors)
+    }
+}
+
+fn project() -> (PathBuf, String) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    (root.join("src"), std::fs::read_to_string(root.join("docs/architecture.md")).unwrap())
+}
+
+#[test]
+fn modules_form_layers_in_the_documented_order_without_cycles() {
+    let (src, page) = project();
+    let layers = documented_layers(&page);
+    assert!(layers.len() >= 6, "the layers table: {layers:?}");
+    match check(&src, &page) {
+        Ok(l) => {
+            println!(
+                "{} modules in {} layers; {} edges between siblings, {} between layers; no cycle, none upward",
+                l.modules,
+                layers.len(),
+                l.sibling_edges,
+                l.layer_edges
+            );
+            assert!(
+                l.sibling_edges > 100,
+                "too few edges were read ({}): is the source where the test looks?",
+                l.sibling_edges
+            );
+        }
+        Err(errors) => panic!("{}", errors.join("\n")),
+    }
+}
+
+#[test]
+fn grouped_imports_and_re_exports_are_read() {
+    let code = "use super::{device::Device, sync::{Access, Recording}, self};\nuse crate::{a::b as c, d};";
+    let paths = referenced_paths(&["vk".into(), "buffer".into()], code);
+    let expected: Vec<Vec<String>> = [
+        vec!["vk", "device", "Device"],
+        vec!["vk", "sync", "Access"],
+        vec!["vk", "sync", "Recording"],
+        vec!["vk"],
+        vec!["a", "b"],
+        vec!["d"],
+    ]
+    .iter()
+    .map(|p| p.iter().map(|s| s.to_string()).collect())
+    .collect();
+    assert_eq!(paths, expected);
+}
+
+/// A copy of the source with `insert` added after the first line of
+/// `file`, checked.
+fn check_with(file: &str, insert: &str) -> Result<Layering, Vec<String>> {
+    let (src, page) = project();
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    for f in &files {
+        let to = copy.join(f.strip_prefix(&src).unwrap());
+        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+        std::fs::copy(f, &to).unwrap();
+    }
+    let target = copy.join(file);
+    let text = std::fs::read_to_string(&target).unwrap();
+    let (first, rest) = text.split_once('\n').unwrap();
+    std::fs::write(&target, format!("{first}\n{insert}\n{rest}")).unwrap();
+    check(&copy, &page)
+}
+
+#[test]
+fn an_injected_cycle_inside_vk_through_a_grouped_import_is_caught() {
+    // buffer.rs uses sync's Recording (through vk's re-export); sync using
+    // buffer back closes a cycle.
+    let errors = check_with("vk/sync.rs", "use super::{buffer::Buffer, Device};").err().expect("a cycle");
+    println!("{}", errors.join("\n"));
+    assert!(errors.iter().any(|e| e.starts_with("a module cycle within vk:")), "{errors:?}");
+}
+
+#[test]
+fn an_injected_core_module_using_a_tool_is_caught() {
+    let errors = check_with("model/geometry/mod.rs", "use crate::{tools::metrics::relative_mse};")
+        .err()
+        .expect("an upward edge");
+    println!("{}", errors.join("\n"));
+    assert!(errors.iter().any(|e| e.contains("uses `tools::metrics`") && e.contains("a layer above it")), "{errors:?}");
 }

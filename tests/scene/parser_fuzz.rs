@@ -9,7 +9,7 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
-use quadray::scene::parse_scene;
+use quadray::model::scene::parse_scene;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 

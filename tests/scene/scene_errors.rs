@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use quadray::scene::{
+use quadray::model::scene::{
     load_scene, parse_scene, ConductorFresnel, Light, MaterialKind, Scene, SceneError, DEFAULT_SCENE,
     DEFAULT_SCENE_NAME,
 };
@@ -989,7 +989,7 @@ fn textured_example_scene() {
     assert!(!s.textures.is_empty());
     assert!(s.materials.iter().any(|m| m.maps.albedo.is_some()));
     assert!(s.materials.iter().any(|m| m.maps.normal.is_some()));
-    assert!(s.objects.iter().any(|o| matches!(o.uv.mapping, quadray::scene::UvMapping::Planar { .. })));
+    assert!(s.objects.iter().any(|o| matches!(o.uv.mapping, quadray::model::scene::UvMapping::Planar { .. })));
     for t in &s.textures {
         assert!(t.width.is_power_of_two() && t.height.is_power_of_two(), "{}", t.source);
         assert_eq!(t.levels[0].len(), (t.width * t.height) as usize);
@@ -1167,7 +1167,7 @@ fn sky_example_scene() {
     let env = s.environment.expect("an environment map");
     assert_eq!(env.scale, 1.0);
     let sky = &s.textures[env.texture];
-    assert_eq!(*sky, quadray::sampling::envmap::procedural_sky(512, 256));
+    assert_eq!(*sky, quadray::model::sampling::envmap::procedural_sky(512, 256));
     // A glossy metal sphere and a diffuse floor.
     let material = |name: &str| &s.materials[s.objects.iter().find(|o| o.name == name).unwrap().material];
     let MaterialKind::Conductor { roughness, .. } = material("metal sphere").kind else { panic!("not a metal") };

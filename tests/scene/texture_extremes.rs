@@ -19,12 +19,12 @@
 use crate::common;
 
 use glam::{DAffine3, DVec2, DVec3, Vec3};
-use quadray::geometry::uv::object_uv;
-use quadray::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::geometry::uv::object_uv;
+use quadray::model::geometry::{Aabb, FunctionalObject, Quadric};
+use quadray::model::scene::{FilterMode, Material, MaterialMaps, Scene, UvMapping, UvSettings};
+use quadray::model::texture::encoding::TexelEncoding;
+use quadray::model::texture::{from_texels, MAX_TEXTURE_SIZE};
 use quadray::passes::RenderVariant;
-use quadray::scene::{FilterMode, Material, MaterialMaps, Scene, UvMapping, UvSettings};
-use quadray::texture::encoding::TexelEncoding;
-use quadray::texture::{from_texels, MAX_TEXTURE_SIZE};
 
 const SIZE: (u32, u32) = (96, 64);
 
@@ -41,7 +41,7 @@ const TEXTURE_SCALE: f64 = 0.04;
 /// about ±0.05 of the map at the grazing end at twice this scale, where
 /// the 16k ramp's error grew to 0.024 at the floor's sides; 1.8e-7 at this
 /// scale).
-fn floor_scene(texture: quadray::scene::TextureImage) -> Scene {
+fn floor_scene(texture: quadray::model::scene::TextureImage) -> Scene {
     let floor = FunctionalObject {
         base: Quadric::from_coefficients([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0]),
         perturbations: vec![],

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use exr::prelude::{AnyChannel, AnyChannels, FlatSamples, SmallVec, WritableImage};
-use quadray::texture::{
+use quadray::model::texture::{
     build_mips, bump_heights, checker, from_texels, load_texture, load_texture_file, normals_from_heights,
     resample_to_power_of_two, srgb_to_linear, TextureError, TextureKind, TextureUsage, MAX_TEXTURE_SIZE,
 };

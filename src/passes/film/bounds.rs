@@ -8,7 +8,7 @@ use std::str::FromStr;
 
 /// A rectangle of pixels of a `frame_width` x `frame_height` frame,
 /// half-open: columns `x0..x1`, rows `y0..y1` (row 0 at the top).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct PixelBounds {
     /// First column.
     pub x0: u32,

@@ -9,9 +9,37 @@ pub mod bounds;
 
 pub use bounds::{BoundsError, PixelBounds, TileIndex};
 
-use super::caustics::CausticReport;
 use super::gpu::GpuAov;
 use crate::vk::Backend;
+
+/// What the caustic passes did, and how long they took (a render's
+/// output carries it; `passes::caustics` fills it).
+#[derive(Clone, Debug, Default)]
+pub struct CausticReport {
+    /// Caustic rays traced (all grids).
+    pub rays: u64,
+    /// Rays that landed on a diffuse receiver after a specular vertex.
+    pub landed: u64,
+    /// Emission grids (lights × light samples).
+    pub grids: usize,
+    /// GPU time of the G-buffer pass (s).
+    pub gbuffer_seconds: f64,
+    /// GPU time of the caustic-ray pass (s).
+    pub trace_seconds: f64,
+    /// GPU time of the caustic-cell splat pass (s).
+    pub splat_seconds: f64,
+    /// GPU time of the volumetric-caustic (beam) pass (s); 0 without fog.
+    pub beam_seconds: f64,
+    /// Caustic irradiance per pixel (W/m², RGB) at the pixel-centre receiver.
+    pub irradiance: Vec<[f32; 3]>,
+}
+
+impl CausticReport {
+    /// Total GPU time of the caustic passes (s).
+    pub fn seconds(&self) -> f64 {
+        self.gbuffer_seconds + self.trace_seconds + self.splat_seconds + self.beam_seconds
+    }
+}
 
 /// What a render produces: linear radiance and AOVs, row 0 at the top, for
 /// the pixels of `bounds` (the whole frame, or a crop or tile of it).
@@ -26,7 +54,7 @@ pub struct RenderOutput {
     pub frame_size: (u32, u32),
     /// Mean radiance per pixel (linear RGB).
     pub radiance: Vec<[f32; 3]>,
-    /// The radiance denoised (Intel Open Image Denoise, `crate::denoise`),
+    /// The radiance denoised (Intel Open Image Denoise, `crate::jobs::denoise`),
     /// when the render was: the PNG and the EXR's RGB show it, and
     /// `radiance` stays beside it as the EXR's `noisy.RGB`.
     pub denoised: Option<Vec<[f32; 3]>>,
@@ -60,6 +88,9 @@ pub struct RenderOutput {
     /// The backend every tracing pass ran on (`None` for an image read from
     /// a file).
     pub backend: Option<Backend>,
+    /// Where the wavefront pass's GPU time went, stage by stage (`None`
+    /// when the megakernel ran, or for an image read from a file).
+    pub wave_profile: Option<crate::passes::wavefront::WaveProfile>,
 }
 
 impl RenderOutput {
@@ -88,6 +119,7 @@ impl RenderOutput {
             dropped_samples: 0,
             max_sample: vec![],
             backend: None,
+            wave_profile: None,
         }
     }
 }
@@ -158,6 +190,7 @@ impl Accumulation {
             dropped_samples,
             max_sample: self.max_sample,
             backend: None,
+            wave_profile: None,
         }
     }
 }

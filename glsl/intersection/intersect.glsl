@@ -1,0 +1,32 @@
+// Ray intersection with functional objects through ray queries.
+//
+// F'(p) = F(p) + Σ f_i max(Q_i(p), 0)³ (NOTES.md eq. 1-2), inside where F' >= 0.
+// Each candidate AABB is a cell of one object that lists the perturbations
+// that can be non-zero in it. Along the ray inside the cell, F and each Q_i
+// are quadratics in t; the roots of the Q_i cut the segment into pieces on
+// which F' is a polynomial of degree <= 6, whose first root is isolated
+// exactly (roots.glsl). The f64 twin is src/model/geometry/reference.rs.
+#ifndef INTERSECT_GLSL
+#define INTERSECT_GLSL
+
+#include "interface.glsl"
+#include "roots.glsl"
+
+// Specialisation constant for cost breakdowns (benchmarks): INTERSECT_FULL,
+// INTERSECT_BOXES (each candidate box reports a hit where the ray enters it:
+// traversal cost only) or INTERSECT_BASE (perturbations ignored: the base
+// quadric's roots in each box).
+layout(constant_id = SPEC_INTERSECT_MODE) const uint INTERSECT_MODE = INTERSECT_FULL;
+
+// The parts, each one concept:
+#include "quadric.glsl"
+#include "root_search.glsl"
+#include "derivatives.glsl"
+#include "hit.glsl"
+#ifdef RAY_TRACING_PIPELINE
+#include "traverse_pipeline.glsl"
+#else
+#include "traverse.glsl"
+#endif
+
+#endif
