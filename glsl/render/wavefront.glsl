@@ -96,6 +96,9 @@ void enqueueNext(uint slot, bool goesOn) {
         base = atomicAdd(waveCounts[next], n);
         atomicMax(waveArgs[3u * next], (base + n + WAVE_GROUP - 1u) / WAVE_GROUP);
     }
+    // The elected lane's count, once the subgroup has left the branch
+    // (structured control flow reconverges at its merge; the usual pattern
+    // of stream compaction, e.g. in pbrt-v4's GPU queues).
     base = subgroupBroadcastFirst(base);
     if (goesOn) waveItems[next * WAVE_SLOTS + base + subgroupBallotExclusiveBitCount(ballot)] = slot;
 }

@@ -93,8 +93,9 @@ pub fn image_key(scene: &Scene, variant: RenderVariant) -> u64 {
 }
 
 /// `variant` without the switches that leave the image as it is: the path
-/// kernel (the megakernel and the wavefront pass make the same image to the
-/// bit, tests/render/kernels.rs), so that a render checkpointed with one
+/// kernel (the megakernel and the wavefront pass run the same code on the
+/// same random numbers; measured identical to the bit on lavapipe,
+/// tests/render/kernels.rs), so that a render checkpointed with one
 /// resumes with the other and their tiles merge.
 fn keyed_variant(variant: RenderVariant) -> RenderVariant {
     RenderVariant { kernel: None, ..variant }
@@ -225,9 +226,10 @@ mod tests {
 
     /// The key of the built-in default scene, pinned: it comes from a
     /// stable serialisation (`render_key`), so only a change to the scene
-    /// model, the variant or `KEY_VERSION` moves it. When this fails, old
-    /// checkpoints no longer resume: bump `KEY_VERSION` if the image an
-    /// unchanged scene file makes has changed, and update the value.
+    /// model, the variant, `KEY_VERSION` or `scenes/default.toml` itself
+    /// moves it. When this fails, old checkpoints no longer resume: bump
+    /// `KEY_VERSION` if the image an unchanged scene file makes has changed
+    /// (not for an edit of default.toml), and update the value.
     #[test]
     fn the_default_scenes_key_is_stable() {
         let scene = crate::model::scene::parse_scene(crate::model::scene::DEFAULT_SCENE, "default").unwrap();

@@ -73,7 +73,8 @@ pub struct WaveProfile {
     pub trace: f64,
     /// The shade kernel: the paths' events, and their samples added.
     pub shade: f64,
-    /// Between the stages: emptying queues, reading their lengths.
+    /// Between the stages: emptying queues, the barriers, submissions (the
+    /// copy of the queues' lengths falls in the last shade's interval).
     pub other: f64,
     /// Trace-and-shade iterations run.
     pub iterations: u64,
@@ -129,8 +130,9 @@ impl Wavefront {
             MemoryLocation::GpuToCpu,
         )?;
         // A path traces at most 4 maxDepth + 8 segments (pathGoesOn), each
-        // followed by at most two shadow rays; one more to see it end.
-        let max_iterations = 3 * (4 * max_depth.max(1) + 8) + 1;
+        // followed by at most two shadow rays; the shade stage that answers
+        // its last ray adds its sample.
+        let max_iterations = 3 * (4 * max_depth.max(1) + 8);
         let stamps = if GpuTimer::new(device)?.is_gpu() { Some(Timestamps::new(device, STAMPS)?) } else { None };
         Ok(Self {
             start,
@@ -213,7 +215,11 @@ impl Wavefront {
                 self.queue.copy_range_to(rec, &self.counts, COUNTS_OFFSET, 8);
                 rec.barrier(&[Access::TransferWrite], &[Access::HostRead]);
                 if let Some(stamps) = &self.stamps {
-                    stamps.write(rec.cmd, 3 * chunk);
+                    // The end, and every query a short chunk leaves unused
+                    // (all are read below).
+                    for index in 3 * chunk..STAMPS {
+                        stamps.write(rec.cmd, index);
+                    }
                 }
             })?;
             seconds += s;
@@ -231,8 +237,15 @@ impl Wavefront {
             profile.iterations += chunk as u64;
             iteration += chunk;
             let counts: Vec<u32> = self.counts.read();
-            if counts[(COUNTS_OFFSET / 4) as usize + (iteration % 2) as usize] == 0 {
+            let live = counts[(COUNTS_OFFSET / 4) as usize + (iteration % 2) as usize];
+            if live == 0 {
                 break;
+            }
+            if iteration >= self.max_iterations {
+                // Cannot happen (the bound holds every path); were it to, the
+                // pixels' finite-sample counts would fall short and the
+                // render would report the samples as dropped.
+                log::warn!("wavefront pass: {live} paths still live after {iteration} iterations");
             }
         }
         self.profile.set(profile);

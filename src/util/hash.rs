@@ -1,6 +1,7 @@
-//! Deterministic pseudo-random numbers from integers, for generated content
-//! (scattered bumps, procedural textures) that must not depend on a random
-//! number generator's state.
+//! Stable hashes: deterministic pseudo-random numbers from integers, for
+//! generated content (scattered bumps, procedural textures) that must not
+//! depend on a random number generator's state, and FNV-1a for keys and
+//! checksums.
 
 /// A number in [0, 1) from a seed, an index and a stream: the seed and the
 /// index packed into 64 bits, mixed with the stream, then the SplitMix64
@@ -17,8 +18,8 @@ pub fn hash_unit(seed: u32, index: u64, stream: u64) -> f64 {
 }
 
 /// FNV-1a, 64 bits (Fowler, Noll and Vo): a stable hash for cache keys and
-/// checksums (not a cryptographic one). Implements `fmt::Write`, so that a
-/// value's `Debug` form can be hashed without building the string.
+/// checksums (not a cryptographic one). Implements `io::Write`, so that a
+/// serialiser can stream a value into it without building the string.
 #[derive(Clone, Copy, Debug)]
 pub struct Fnv1a(u64);
 
@@ -44,13 +45,6 @@ impl Fnv1a {
         let mut h = Self::default();
         h.update(bytes);
         h.finish()
-    }
-}
-
-impl std::fmt::Write for Fnv1a {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        self.update(s.as_bytes());
-        Ok(())
     }
 }
 

@@ -43,16 +43,49 @@ fn module_of(relative: &Path) -> Vec<String> {
 }
 
 /// The file's code without its comments (line comments; doc comments are
-/// line comments too) and without its unit tests: everything from the
-/// `#[cfg(test)]` line of a `mod` on (the test module, which by the
-/// project's convention closes the file), whose imports are test-only
-/// edges.
+/// line comments too) and without its inline unit tests: everything from
+/// the `#[cfg(test)]` line of a `mod NAME {` on (the test module, which by
+/// the project's convention closes the file), whose imports are test-only
+/// edges. (Out-of-line test modules, `#[cfg(test)] mod tests;`, are left
+/// out whole: `test_files`.)
 fn code_of(text: &str) -> String {
     let lines: Vec<&str> = text.lines().collect();
     let end = (0..lines.len())
-        .find(|&i| lines[i].trim() == "#[cfg(test)]" && lines.get(i + 1).is_some_and(|l| l.starts_with("mod ")))
+        .find(|&i| {
+            lines[i].trim() == "#[cfg(test)]"
+                && lines.get(i + 1).is_some_and(|l| l.starts_with("mod ") && l.trim_end().ends_with('{'))
+        })
         .unwrap_or(lines.len());
     lines[..end].iter().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n")
+}
+
+/// The files of out-of-line unit-test modules: `#[cfg(test)]` then
+/// `mod NAME;` in a file makes `NAME.rs` beside it (or in its folder, for a
+/// `mod.rs`) a test file.
+fn test_files(src: &Path, files: &[PathBuf]) -> BTreeSet<PathBuf> {
+    let mut out = BTreeSet::new();
+    for file in files {
+        let text = std::fs::read_to_string(file).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        for w in lines.windows(2) {
+            let Some(name) = w[1].trim().strip_prefix("mod ").and_then(|r| r.strip_suffix(';')) else { continue };
+            if w[0].trim() != "#[cfg(test)]" {
+                continue;
+            }
+            let stem = file.file_stem().unwrap().to_string_lossy();
+            let dir = if matches!(stem.as_ref(), "mod" | "lib" | "main") {
+                file.parent().unwrap().to_path_buf()
+            } else {
+                file.with_extension("")
+            };
+            for candidate in [dir.join(format!("{name}.rs")), dir.join(name).join("mod.rs")] {
+                if candidate.starts_with(src) && candidate.exists() {
+                    out.insert(candidate);
+                }
+            }
+        }
+    }
+    out
 }
 
 fn is_ident(c: u8) -> bool {
@@ -189,12 +222,22 @@ fn re_exports(
         while let Some(k) = code[from..].find("pub use ") {
             let mut j = from + k + "pub use ".len();
             from = j;
+            let statement_end = code[j..].find(';').map_or(code.len(), |e| j + e);
+            let statement = &code[j..statement_end];
             for path in use_tree(s, &mut j) {
                 let (Some(child), Some(last)) = (path.first(), path.last()) else { continue };
                 let mut child_module = module.clone();
                 child_module.push(child.clone());
                 if path.len() >= 2 && modules.contains(&child_module) {
                     out.insert((module.clone(), last.clone()), child.clone());
+                    // `Name as Alias`: users name the alias.
+                    let words: Vec<&str> = statement.split(|c: char| !(c.is_alphanumeric() || c == '_')).collect();
+                    let words: Vec<&str> = words.into_iter().filter(|w| !w.is_empty()).collect();
+                    for k in 0..words.len().saturating_sub(2) {
+                        if words[k] == last && words[k + 1] == "as" {
+                            out.insert((module.clone(), words[k + 2].to_string()), child.clone());
+                        }
+                    }
                 }
             }
         }
@@ -285,6 +328,7 @@ fn check(src: &Path, page: &str) -> Result<Layering, Vec<String>> {
     let modules: BTreeSet<Vec<String>> =
         files.iter().map(|f| module_of(f.strip_prefix(src).unwrap())).filter(|m| !m.is_empty()).collect();
     let exports = re_exports(src, &files, &modules);
+    let tests = test_files(src, &files);
     // Edges between the modules two paths' longest module prefixes name
     // (through a folder's re-export to the child that defines the name).
     let mut edges: BTreeSet<(Vec<String>, Vec<String>)> = BTreeSet::new();
@@ -292,11 +336,21 @@ fn check(src: &Path, page: &str) -> Result<Layering, Vec<String>> {
         let module = module_of(file.strip_prefix(src).unwrap());
         // main.rs is the binary (it uses the library by name); the root
         // (lib.rs) holds the shared error types.
-        if module.is_empty() {
+        if module.is_empty() || tests.contains(file) {
             continue;
         }
         let code = code_of(&std::fs::read_to_string(file).unwrap());
         for path in referenced_paths(&module, &code) {
+            // A name the crate root re-exports (`crate::RenderError`) is
+            // its defining module's.
+            let path = match path.first().and_then(|name| exports.get(&(Vec::new(), name.clone()))) {
+                Some(child) if !modules.contains(&path[..1]) => {
+                    let mut p = vec![child.clone()];
+                    p.extend(path);
+                    p
+                }
+                _ => path,
+            };
             let Some(n) = (1..=path.len()).rev().find(|&n| modules.contains(&path[..n])) else { continue };
             let mut target = path[..n].to_vec();
             if let Some(child) = path.get(n).and_then(|item| exports.get(&(target.clone(), item.clone()))) {
@@ -329,8 +383,14 @@ fn check(src: &Path, page: &str) -> Result<Layering, Vec<String>> {
     }
     // The layer order between top-level modules.
     let layers = documented_layers(page);
-    let rank: BTreeMap<&str, usize> =
-        layers.iter().enumerate().flat_map(|(r, (_, ms))| ms.iter().map(move |m| (m.as_str(), r))).collect();
+    let mut rank: BTreeMap<&str, usize> = BTreeMap::new();
+    for (r, (name, ms)) in layers.iter().enumerate() {
+        for m in ms {
+            if let Some(other) = rank.insert(m.as_str(), r) {
+                errors.push(format!("module `{m}` is in two layers of the table: {} and {name}", layers[other].0));
+            }
+        }
+    }
     let top: BTreeSet<&str> = modules.iter().map(|m| m[0].as_str()).collect();
     for m in &top {
         if !rank.contains_key(m) {
@@ -407,6 +467,10 @@ fn grouped_imports_and_re_exports_are_read() {
     .map(|p| p.iter().map(|s| s.to_string()).collect())
     .collect();
     assert_eq!(paths, expected);
+    // An out-of-line test module at the top keeps the rest of the file;
+    // an inline one at the end is cut.
+    let code = code_of("#[cfg(test)]\nmod tests;\nuse crate::a::b;\n#[cfg(test)]\nmod more {\nuse crate::c;\n}");
+    assert_eq!(referenced_paths(&["x".into()], &code), vec![vec!["a".to_string(), "b".to_string()]]);
 }
 
 /// A copy of the source with `insert` added after the first line of
