@@ -308,8 +308,13 @@ pub(crate) fn throughput(args: ThroughputArgs, set_threads: bool) -> Result<()> 
         runs: args.runs,
         binary: quadray::vk::runtime::current_exe().context("cannot find this binary's path")?,
         baseline: args.baseline,
-        backends: args.backends,
-        kernels: args.kernels,
+        side_by_side: if args.backends {
+            Some(quadray::tools::throughput::SideBySide::Backends)
+        } else if args.kernels {
+            Some(quadray::tools::throughput::SideBySide::Kernels)
+        } else {
+            None
+        },
         reference_spp: args.reference_spp,
         out_dir: args.out.clone(),
         // Each binary picks its own lavapipe thread count, as it would alone.

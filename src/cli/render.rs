@@ -369,7 +369,7 @@ pub(crate) fn bench(
     scene: &Scene,
     backend: quadray::vk::Backend,
 ) -> Result<quadray::passes::RenderOutput> {
-    use quadray::passes::{render, GpuScene, RenderVariant};
+    use quadray::passes::{GpuScene, RenderVariant};
     use quadray::vk::Backend;
 
     let device = &ctx.device;
@@ -429,9 +429,7 @@ pub(crate) fn bench(
     let mut full = None;
     let mut rows = Vec::new();
     for (name, variant) in variants {
-        // Untimed warm-up: the shader variant compiles at its first dispatch.
-        quadray::passes::Renderer::warm_up(device, &mut cmds, &gpu, scene, variant)?;
-        let out = render(device, &mut cmds, &gpu, scene, variant, &mut |_, _| {})?;
+        let out = timed_render(device, &mut cmds, &gpu, scene, variant)?;
         let samples = im.width as f64 * im.height as f64 * im.spp as f64;
         rows.push((name, out.seconds, samples / out.seconds));
         if full.is_none() {
@@ -447,39 +445,58 @@ pub(crate) fn bench(
     let mut by_backend = vec![(backend, rows[0].2)];
     for other in Backend::ALL.into_iter().filter(|&b| b != backend && device.offers(b)) {
         let variant = RenderVariant { backend: Some(other), ..variants[0].1 };
-        quadray::passes::Renderer::warm_up(device, &mut cmds, &gpu, scene, variant)?;
-        let out = render(device, &mut cmds, &gpu, scene, variant, &mut |_, _| {})?;
+        let out = timed_render(device, &mut cmds, &gpu, scene, variant)?;
         by_backend.push((other, im.width as f64 * im.height as f64 * im.spp as f64 / out.seconds));
     }
     let line: Vec<String> = by_backend.iter().map(|(b, rate)| format!("{b} {rate:.0}")).collect();
     eprintln!("full render, samples/s by backend: {}", line.join(", "));
-    if device.offers(Backend::RayQuery) {
-        print_kernels(ctx, &mut cmds, &gpu, scene, variants[0].1)?;
-    }
     let full = full.expect("the full render");
+    if device.offers(Backend::RayQuery) {
+        print_kernels(device, &mut cmds, &gpu, scene, (variants[0].1, &full))?;
+    }
     print_frame_table(&full, rows[2].1, im.spp);
     Ok(full)
 }
 
-/// The full render with each kernel (ray queries), side by side, and where
-/// the wavefront pass's time goes stage by stage.
-fn print_kernels(
-    ctx: &quadray::vk::Context,
+/// Renders `scene` with `variant` after an untimed warm-up (lavapipe
+/// compiles the shader variant at its first dispatch).
+fn timed_render(
+    device: &std::sync::Arc<quadray::vk::Device>,
     cmds: &mut quadray::vk::Commands,
     gpu: &quadray::passes::GpuScene,
     scene: &Scene,
-    full: quadray::passes::RenderVariant,
+    variant: quadray::passes::RenderVariant,
+) -> Result<quadray::passes::RenderOutput> {
+    quadray::passes::Renderer::warm_up(device, cmds, gpu, scene, variant)?;
+    Ok(quadray::passes::render(device, cmds, gpu, scene, variant, &mut |_, _| {})?)
+}
+
+/// The render pass with each kernel (ray queries), side by side, and where
+/// the wavefront pass's time goes stage by stage. `full` is the benchmark's
+/// full render and its variant: the kernel it ran is not rendered again.
+fn print_kernels(
+    device: &std::sync::Arc<quadray::vk::Device>,
+    cmds: &mut quadray::vk::Commands,
+    gpu: &quadray::passes::GpuScene,
+    scene: &Scene,
+    (variant, full): (quadray::passes::RenderVariant, &quadray::passes::RenderOutput),
 ) -> Result<()> {
-    use quadray::passes::{render, PathKernel, RenderVariant, Renderer};
+    use quadray::passes::{PathKernel, RenderVariant};
+    use quadray::vk::Backend;
     let samples = scene.image.width as f64 * scene.image.height as f64 * scene.image.spp as f64;
+    let ran = if full.wave_profile.is_some() { PathKernel::Wavefront } else { PathKernel::Megakernel };
     let mut rates = Vec::new();
-    let mut profile = None;
+    let mut profile = full.wave_profile;
     for kernel in PathKernel::ALL {
-        let variant = RenderVariant { kernel: Some(kernel), backend: Some(quadray::vk::Backend::RayQuery), ..full };
-        Renderer::warm_up(&ctx.device, cmds, gpu, scene, variant)?;
-        let out = render(&ctx.device, cmds, gpu, scene, variant, &mut |_, _| {})?;
-        rates.push(format!("{kernel} {:.0}", samples / out.render_seconds));
-        profile = profile.or(out.wave_profile);
+        let seconds = if full.backend == Some(Backend::RayQuery) && kernel == ran {
+            full.render_seconds
+        } else {
+            let v = RenderVariant { kernel: Some(kernel), backend: Some(Backend::RayQuery), ..variant };
+            let out = timed_render(device, cmds, gpu, scene, v)?;
+            profile = profile.or(out.wave_profile);
+            out.render_seconds
+        };
+        rates.push(format!("{kernel} {:.0}", samples / seconds));
     }
     eprintln!("render pass, samples/s by kernel (ray queries): {}", rates.join(", "));
     if let Some(p) = profile {

@@ -133,7 +133,7 @@ impl Wavefront {
         // followed by at most two shadow rays; the shade stage that answers
         // its last ray adds its sample.
         let max_iterations = 3 * (4 * max_depth.max(1) + 8);
-        let stamps = if GpuTimer::new(device)?.is_gpu() { Some(Timestamps::new(device, STAMPS)?) } else { None };
+        let stamps = if GpuTimer::available(device) { Some(Timestamps::new(device, STAMPS)?) } else { None };
         Ok(Self {
             start,
             trace,

@@ -76,12 +76,9 @@ pub struct Config {
     pub binary: PathBuf,
     /// An older binary to measure beside it.
     pub baseline: Option<PathBuf>,
-    /// Measure the new binary with each backend (`--backend ray-query`,
-    /// then `--backend pipeline`) side by side instead of beside a baseline.
-    pub backends: bool,
-    /// Measure the new binary with each path kernel (`--kernel megakernel`,
-    /// then `--kernel wavefront`, ray queries) side by side instead.
-    pub kernels: bool,
+    /// Measure the new binary two ways side by side (each backend, or each
+    /// path kernel) instead of beside a baseline.
+    pub side_by_side: Option<SideBySide>,
     /// Samples per pixel of a reference (rendered once per scene by the new
     /// binary, cached in `out_dir/cache`); none: no reference.
     pub reference_spp: Option<u32>,
@@ -92,6 +89,31 @@ pub struct Config {
     pub env_remove: Vec<String>,
     /// The command line, recorded in the report.
     pub command: String,
+}
+
+/// Two ways of running the new binary, measured side by side.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SideBySide {
+    /// `--backend ray-query`, then `--backend pipeline`.
+    Backends,
+    /// `--kernel megakernel`, then `--kernel wavefront` (ray queries).
+    Kernels,
+}
+
+impl SideBySide {
+    /// The two ways: each one's name and the render flags that select it.
+    fn ways(self) -> [(&'static str, Vec<String>); 2] {
+        let flags = |f: &[&str]| f.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        match self {
+            Self::Backends => {
+                [("ray-query", flags(&["--backend", "ray-query"])), ("pipeline", flags(&["--backend", "pipeline"]))]
+            }
+            Self::Kernels => [
+                ("megakernel", flags(&["--backend", "ray-query", "--kernel", "megakernel"])),
+                ("wavefront", flags(&["--backend", "ray-query", "--kernel", "wavefront"])),
+            ],
+        }
+    }
 }
 
 /// One render process's measurements.
@@ -278,19 +300,9 @@ pub fn run(config: &Config) -> Result<Report, ThroughputError> {
     let warm_flags: Vec<String> =
         ["--width", "64", "--height", "48", "--spp", "1", "--no-denoise"].map(String::from).to_vec();
     // What is measured: (name, binary, extra flags).
-    let mut binaries: Vec<(&str, PathBuf, Vec<String>)> = if config.backends {
-        ["ray-query", "pipeline"]
-            .map(|b| (b, config.binary.clone(), vec!["--backend".to_string(), b.to_string()]))
-            .to_vec()
-    } else if config.kernels {
-        ["megakernel", "wavefront"]
-            .map(|k| {
-                let flags = ["--backend", "ray-query", "--kernel", k].map(String::from).to_vec();
-                (k, config.binary.clone(), flags)
-            })
-            .to_vec()
-    } else {
-        vec![("new", config.binary.clone(), Vec::new())]
+    let mut binaries: Vec<(&str, PathBuf, Vec<String>)> = match config.side_by_side {
+        Some(two) => two.ways().into_iter().map(|(name, flags)| (name, config.binary.clone(), flags)).collect(),
+        None => vec![("new", config.binary.clone(), Vec::new())],
     };
     if let Some(b) = &config.baseline {
         binaries.push(("baseline", b.clone(), Vec::new()));

@@ -79,11 +79,15 @@ pub struct GpuTimer {
 impl GpuTimer {
     /// A timer on `device`'s queue.
     pub fn new(device: &Arc<Device>) -> Result<Self, VkError> {
+        let stamps = if Self::available(device) { Some(Timestamps::new(device, 2)?) } else { None };
+        Ok(Self { stamps })
+    }
+
+    /// True when `device`'s queue writes timestamps.
+    pub fn available(device: &Device) -> bool {
         // SAFETY: `device.physical` is the physical device of `device.raw`, from the live `device.instance`.
         let families = unsafe { device.instance.raw.get_physical_device_queue_family_properties(device.physical) };
-        let valid_bits = families.get(device.queue_family as usize).map_or(0, |f| f.timestamp_valid_bits);
-        let stamps = if valid_bits > 0 { Some(Timestamps::new(device, 2)?) } else { None };
-        Ok(Self { stamps })
+        families.get(device.queue_family as usize).is_some_and(|f| f.timestamp_valid_bits > 0)
     }
 
     /// True when times come from GPU timestamps (not wall clocks).

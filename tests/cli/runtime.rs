@@ -162,7 +162,7 @@ fn the_system_driver_renders_the_test_scenes_as_the_runtime_does() {
     let dir = tempfile::tempdir().unwrap();
     let have = bundled().is_some();
     let mut failures = Vec::new();
-    println!("{:<18} {:>12} {:>10} {:>12} {:>14}", "scene", "max channel", "FLIP", "relMSE", "pixels differ");
+    println!("{:<18} {}", "scene", crate::common::Agreement::header());
     for name in ["materials", "glass_metal", "textures", "lens_fog"] {
         let scene: PathBuf = [env!("CARGO_MANIFEST_DIR"), "scenes/tests", &format!("{name}.toml")].iter().collect();
         let render = |label: &str, extra: &[&str]| {

@@ -21,6 +21,24 @@ pub fn project_scene(relative: &str) -> Scene {
     quadray::model::scene::load_scene(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
+/// Every file under `dir`, in every folder, sorted.
+pub fn files_under(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    let mut folders = vec![dir.to_path_buf()];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path);
+            } else {
+                out.push(path);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
 /// Every test scene (`scenes/tests/*.toml`) at 64x48 and 4 spp with its own
 /// depth, by file name, sorted; at least nine of them.
 pub fn test_scenes() -> Vec<(String, Scene)> {
@@ -431,6 +449,11 @@ impl Agreement {
             differing,
             pixels: a.radiance.len(),
         }
+    }
+
+    /// The heading of [`Agreement::row`]'s columns.
+    pub fn header() -> String {
+        format!("{:>12} {:>10} {:>12} {:>14}", "max channel", "FLIP", "relMSE", "pixels differ")
     }
 
     /// The table row: max channel, FLIP, relMSE, pixels differing.

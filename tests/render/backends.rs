@@ -30,7 +30,7 @@ const MAX_FLIP: f64 = 0.001;
 
 #[test]
 fn every_test_scene_renders_the_same_with_both_backends() {
-    println!("{:<22} {:>12} {:>10} {:>12} {:>14}", "scene", "max channel", "FLIP", "relMSE", "pixels differ");
+    println!("{:<22} {}", "scene", common::Agreement::header());
     let mut failures = Vec::new();
     for (name, scene) in common::test_scenes() {
         let rq = common::render_variant_validated(

@@ -31,7 +31,7 @@ fn variant(kernel: PathKernel) -> RenderVariant {
 
 #[test]
 fn every_test_scene_renders_the_same_with_both_kernels() {
-    println!("{:<22} {:>12} {:>10} {:>12} {:>14}", "scene", "max channel", "FLIP", "relMSE", "pixels differ");
+    println!("{:<22} {}", "scene", common::Agreement::header());
     let mut failures = Vec::new();
     for (name, scene) in common::test_scenes() {
         let mega = common::render_variant_validated(&scene, variant(PathKernel::Megakernel));

@@ -213,24 +213,15 @@ fn the_checks_fail_on_a_swapped_field_a_wrong_binding_and_an_unknown_constant() 
     assert!(matches!(err, InterfaceError::UnknownSpecConstant { id: SPEC_PROBE_CURVATURE, .. }), "{err}");
 }
 
-/// The file names under `dir`, in every folder.
-fn tree_names(dir: &std::path::Path, out: &mut Vec<String>) {
-    for entry in std::fs::read_dir(dir).unwrap().flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            tree_names(&path, out);
-        } else if let Some(name) = path.file_name().and_then(|n| n.to_str()) {
-            out.push(name.to_string());
-        }
-    }
-}
-
 #[test]
 fn every_shader_in_glsl_is_compiled_and_listed() {
     let names = |suffixes: &[&str]| -> Vec<String> {
-        let mut files = Vec::new();
-        tree_names(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl")), &mut files);
-        files.retain(|n| suffixes.iter().any(|s| n.ends_with(s)));
+        let mut files: Vec<String> =
+            crate::common::files_under(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl")))
+                .iter()
+                .filter_map(|p| p.file_name()?.to_str().map(str::to_string))
+                .filter(|n| suffixes.iter().any(|s| n.ends_with(s)))
+                .collect();
         files.sort();
         files
     };

@@ -19,15 +19,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Every `.rs` file under `dir`.
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    crate::common::files_under(dir).into_iter().filter(|p| p.extension().is_some_and(|e| e == "rs")).collect()
 }
 
 /// The module path of a file relative to `src/`: `passes/film/mod.rs` is
@@ -62,11 +55,11 @@ fn code_of(text: &str) -> String {
 /// The files of out-of-line unit-test modules: `#[cfg(test)]` then
 /// `mod NAME;` in a file makes `NAME.rs` beside it (or in its folder, for a
 /// `mod.rs`) a test file.
-fn test_files(src: &Path, files: &[PathBuf]) -> BTreeSet<PathBuf> {
+fn test_files(src: &Path, sources: &[Source]) -> BTreeSet<PathBuf> {
     let mut out = BTreeSet::new();
-    for file in files {
-        let text = std::fs::read_to_string(file).unwrap();
-        let lines: Vec<&str> = text.lines().collect();
+    for source in sources {
+        let file = &source.file;
+        let lines: Vec<&str> = source.text.lines().collect();
         for w in lines.windows(2) {
             let Some(name) = w[1].trim().strip_prefix("mod ").and_then(|r| r.strip_suffix(';')) else { continue };
             if w[0].trim() != "#[cfg(test)]" {
@@ -88,14 +81,26 @@ fn test_files(src: &Path, files: &[PathBuf]) -> BTreeSet<PathBuf> {
     out
 }
 
+/// A source file, read once: its path, module, text and code (`code_of`).
+struct Source {
+    file: PathBuf,
+    module: Vec<String>,
+    text: String,
+    code: String,
+}
+
 fn is_ident(c: u8) -> bool {
     c.is_ascii_alphanumeric() || c == b'_'
 }
 
-/// The paths of the use tree (or plain path) at byte `*i` of `s`, each as
-/// its identifiers: `a::{b, c::{d, e as f}, self}` gives `[a, b]`,
-/// `[a, c, d]`, `[a, c, e]` and `[a]`. Stops where the tree ends.
-fn use_tree(s: &[u8], i: &mut usize) -> Vec<Vec<String>> {
+/// One path of a use tree, as its identifiers, and the alias it is
+/// imported under (`e as f`), if any.
+type UsePath = (Vec<String>, Option<String>);
+
+/// The paths of the use tree (or plain path) at byte `*i` of `s`:
+/// `a::{b, c::{d, e as f}, self}` gives `[a, b]`, `[a, c, d]`, `[a, c, e]`
+/// (alias `f`) and `[a]`. Stops where the tree ends.
+fn use_tree(s: &[u8], i: &mut usize) -> Vec<UsePath> {
     let skip_ws = |i: &mut usize| {
         while *i < s.len() && s[*i].is_ascii_whitespace() {
             *i += 1;
@@ -135,19 +140,20 @@ fn use_tree(s: &[u8], i: &mut usize) -> Vec<Vec<String>> {
     if s[*i..].starts_with(b"::") {
         *i += 2;
         let rest = use_tree(s, i);
-        let mut out: Vec<Vec<String>> = rest
+        let mut out: Vec<UsePath> = rest
             .into_iter()
-            .map(|mut p| {
+            .map(|(mut p, alias)| {
                 p.insert(0, segment.clone());
-                p
+                (p, alias)
             })
             .collect();
         if out.is_empty() {
-            out.push(vec![segment]);
+            out.push((vec![segment], None));
         }
         return out;
     }
     // `name as alias`: the alias is what the file uses; the path is `name`.
+    let mut alias = None;
     let mut j = *i;
     while j < s.len() && s[j].is_ascii_whitespace() {
         j += 1;
@@ -157,16 +163,18 @@ fn use_tree(s: &[u8], i: &mut usize) -> Vec<Vec<String>> {
         while j < s.len() && s[j].is_ascii_whitespace() {
             j += 1;
         }
+        let start = j;
         while j < s.len() && is_ident(s[j]) {
             j += 1;
         }
+        alias = Some(String::from_utf8_lossy(&s[start..j]).into_owned());
         *i = j;
     }
     // `self` names the path so far; `*` and other names are items.
     if segment == "self" {
-        return vec![vec![]];
+        return vec![(vec![], alias)];
     }
-    vec![vec![segment]]
+    vec![(vec![segment], alias)]
 }
 
 /// The paths a file names from the crate root: `crate::` paths as they
@@ -181,7 +189,7 @@ fn referenced_paths(module: &[String], code: &str) -> Vec<Vec<String>> {
         let boundary = i == 0 || !(is_ident(s[i - 1]) || s[i - 1] == b':');
         if boundary && rest.starts_with(b"crate::") {
             let mut j = i + "crate::".len();
-            out.extend(use_tree(s, &mut j));
+            out.extend(use_tree(s, &mut j).into_iter().map(|(p, _)| p));
             i = j.max(i + 1);
         } else if boundary && rest.starts_with(b"super::") {
             // `super` is the parent of the file's module (a folder's mod.rs
@@ -192,7 +200,7 @@ fn referenced_paths(module: &[String], code: &str) -> Vec<Vec<String>> {
                 base.pop();
                 j += "super::".len();
             }
-            for p in use_tree(s, &mut j) {
+            for (p, _) in use_tree(s, &mut j) {
                 let mut full = base.clone();
                 full.extend(p);
                 out.push(full);
@@ -207,37 +215,21 @@ fn referenced_paths(module: &[String], code: &str) -> Vec<Vec<String>> {
 
 /// What each folder module re-exports from its children: the names of
 /// `pub use child::{A, B as C}` in its `mod.rs` (or `lib.rs`), by folder
-/// and name, to the child that defines them.
-fn re_exports(
-    src: &Path,
-    files: &[PathBuf],
-    modules: &BTreeSet<Vec<String>>,
-) -> BTreeMap<(Vec<String>, String), String> {
+/// and name (the alias where there is one), to the child that defines them.
+fn re_exports(sources: &[Source], modules: &BTreeSet<Vec<String>>) -> BTreeMap<(Vec<String>, String), String> {
     let mut out = BTreeMap::new();
-    for file in files {
-        let module = module_of(file.strip_prefix(src).unwrap());
-        let code = code_of(&std::fs::read_to_string(file).unwrap());
-        let s = code.as_bytes();
+    for source in sources {
+        let s = source.code.as_bytes();
         let mut from = 0;
-        while let Some(k) = code[from..].find("pub use ") {
+        while let Some(k) = source.code[from..].find("pub use ") {
             let mut j = from + k + "pub use ".len();
             from = j;
-            let statement_end = code[j..].find(';').map_or(code.len(), |e| j + e);
-            let statement = &code[j..statement_end];
-            for path in use_tree(s, &mut j) {
+            for (path, alias) in use_tree(s, &mut j) {
                 let (Some(child), Some(last)) = (path.first(), path.last()) else { continue };
-                let mut child_module = module.clone();
+                let mut child_module = source.module.clone();
                 child_module.push(child.clone());
                 if path.len() >= 2 && modules.contains(&child_module) {
-                    out.insert((module.clone(), last.clone()), child.clone());
-                    // `Name as Alias`: users name the alias.
-                    let words: Vec<&str> = statement.split(|c: char| !(c.is_alphanumeric() || c == '_')).collect();
-                    let words: Vec<&str> = words.into_iter().filter(|w| !w.is_empty()).collect();
-                    for k in 0..words.len().saturating_sub(2) {
-                        if words[k] == last && words[k + 1] == "as" {
-                            out.insert((module.clone(), words[k + 2].to_string()), child.clone());
-                        }
-                    }
+                    out.insert((source.module.clone(), alias.unwrap_or_else(|| last.clone())), child.clone());
                 }
             }
         }
@@ -322,25 +314,29 @@ struct Layering {
 /// cycles at every level, and the layer order at the top. Errors say what
 /// is wrong, one line each.
 fn check(src: &Path, page: &str) -> Result<Layering, Vec<String>> {
-    let mut files = Vec::new();
-    rust_files(src, &mut files);
+    let files = rust_files(src);
+    let sources: Vec<Source> = files
+        .into_iter()
+        .map(|file| {
+            let text = std::fs::read_to_string(&file).unwrap();
+            let code = code_of(&text);
+            Source { module: module_of(file.strip_prefix(src).unwrap()), file, text, code }
+        })
+        .collect();
     // Every module of the crate, to tell module names from items in paths.
-    let modules: BTreeSet<Vec<String>> =
-        files.iter().map(|f| module_of(f.strip_prefix(src).unwrap())).filter(|m| !m.is_empty()).collect();
-    let exports = re_exports(src, &files, &modules);
-    let tests = test_files(src, &files);
+    let modules: BTreeSet<Vec<String>> = sources.iter().map(|s| s.module.clone()).filter(|m| !m.is_empty()).collect();
+    let exports = re_exports(&sources, &modules);
+    let tests = test_files(src, &sources);
     // Edges between the modules two paths' longest module prefixes name
     // (through a folder's re-export to the child that defines the name).
     let mut edges: BTreeSet<(Vec<String>, Vec<String>)> = BTreeSet::new();
-    for file in &files {
-        let module = module_of(file.strip_prefix(src).unwrap());
+    for Source { file, module, code, .. } in &sources {
         // main.rs is the binary (it uses the library by name); the root
         // (lib.rs) holds the shared error types.
         if module.is_empty() || tests.contains(file) {
             continue;
         }
-        let code = code_of(&std::fs::read_to_string(file).unwrap());
-        for path in referenced_paths(&module, &code) {
+        for path in referenced_paths(module, code) {
             // A name the crate root re-exports (`crate::RenderError`) is
             // its defining module's.
             let path = match path.first().and_then(|name| exports.get(&(Vec::new(), name.clone()))) {
@@ -467,6 +463,15 @@ fn grouped_imports_and_re_exports_are_read() {
     .map(|p| p.iter().map(|s| s.to_string()).collect())
     .collect();
     assert_eq!(paths, expected);
+    // The alias a re-export is known by.
+    let uses = use_tree(b"a::{b as c, d}", &mut 0);
+    assert_eq!(
+        uses,
+        vec![
+            (vec!["a".to_string(), "b".to_string()], Some("c".to_string())),
+            (vec!["a".to_string(), "d".to_string()], None)
+        ]
+    );
     // An out-of-line test module at the top keeps the rest of the file;
     // an inline one at the end is cut.
     let code = code_of("#[cfg(test)]\nmod tests;\nuse crate::a::b;\n#[cfg(test)]\nmod more {\nuse crate::c;\n}");
@@ -479,9 +484,7 @@ fn check_with(file: &str, insert: &str) -> Result<Layering, Vec<String>> {
     let (src, page) = project();
     let dir = tempfile::tempdir().unwrap();
     let copy = dir.path().join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    for f in &files {
+    for f in &rust_files(&src) {
         let to = copy.join(f.strip_prefix(&src).unwrap());
         std::fs::create_dir_all(to.parent().unwrap()).unwrap();
         std::fs::copy(f, &to).unwrap();
