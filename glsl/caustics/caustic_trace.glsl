@@ -21,15 +21,13 @@
 
 layout(set = 0, binding = BINDING_CAUSTIC_RAYS, scalar) buffer CausticRays { CausticRay causticRays[]; };
 
-
-layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials { Material materials[]; };
-
+#include "materials.glsl"
 #include "stack.glsl"
 
 layout(push_constant, scalar) uniform PushBlock { CausticPush pc; };
 
-// Specialisation constant: 1 when the scene has a participating medium.
-layout(constant_id = SPEC_MEDIA_ENABLED) const uint MEDIA_ENABLED = 0u;
+// MEDIA_ENABLED: 1 when the scene has a participating medium.
+#include "spec_constants.glsl"
 
 // FNV-1a step: the path identifier of a ray so far, extended by `value`.
 uint extendPath(uint path, uint value) { return (path ^ value) * 16777619u; }

@@ -20,6 +20,8 @@
 
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
+#include "common.glsl"
+
 uint gcdOf(uint a, uint b) {
     while (b != 0u) { LOOP_EDGE();
         uint r = a % b;

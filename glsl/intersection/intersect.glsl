@@ -11,12 +11,9 @@
 
 #include "interface.glsl"
 #include "roots.glsl"
-
-// Specialisation constant for cost breakdowns (benchmarks): INTERSECT_FULL,
-// INTERSECT_BOXES (each candidate box reports a hit where the ray enters it:
-// traversal cost only) or INTERSECT_BASE (perturbations ignored: the base
-// quadric's roots in each box).
-layout(constant_id = SPEC_INTERSECT_MODE) const uint INTERSECT_MODE = INTERSECT_FULL;
+// INTERSECT_MODE (cost breakdowns: the whole search, the boxes alone, the
+// base quadric alone) and FAR_RAYS.
+#include "spec_constants.glsl"
 
 // The parts, each one concept:
 #include "quadric.glsl"

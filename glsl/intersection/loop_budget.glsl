@@ -17,9 +17,10 @@
 #ifndef LOOP_BUDGET_GLSL
 #define LOOP_BUDGET_GLSL
 
-#include "gpu_structs.glsl"
+#extension GL_EXT_scalar_block_layout : require
 
-layout(constant_id = SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
+#include "gpu_structs.glsl"
+#include "spec_constants.glsl"
 
 layout(set = 0, binding = BINDING_LOOP_BUDGET, std430) buffer LoopBudgetBuffer { LoopBudget loopBudget; };
 

@@ -6,6 +6,7 @@
 #define ROOT_SEARCH_GLSL
 
 #include "quadric.glsl"
+#include "spec_constants.glsl"
 
 // ---------------------------------------------------------------------------
 // f64 refinement. The f32 search works on F' expanded around each piece's
@@ -304,11 +305,11 @@ float cellFirstRoot(uint object, uint cellIndex, vec3 o, vec3 d, bool rebased, d
 // returned in f64 (docs/stability.md, "Far views").
 // ---------------------------------------------------------------------------
 
-// 0 when no ray of the scene starts beyond any object's rebaseDistance
-// (GpuScene::far_rays, decided on the host from how far the scene, its
-// lights and the camera's keyframes reach): the far-ray search and the
-// per-candidate load of rebaseDistance then compile out.
-layout(constant_id = SPEC_FAR_RAYS) const uint FAR_RAYS = 1u;
+// FAR_RAYS (spec_constants.glsl) is 0 when no ray of the scene starts
+// beyond any object's rebaseDistance (GpuScene::far_rays, decided on the
+// host from how far the scene, its lights and the camera's keyframes
+// reach): the far-ray search and the per-candidate load of rebaseDistance
+// then compile out.
 
 // The ray in object `object`'s frame, in f64: its f64 world-to-object map
 // applied to the f32 world origin and direction.

@@ -17,6 +17,9 @@
 #ifndef COVARIANCE_GLSL
 #define COVARIANCE_GLSL
 
+#include "common.glsl"
+#include "texfilter.glsl"
+
 struct PathCovariance {
     // The primal covariance of (x, y, θ, φ) in 2 x 2 blocks (every operator
     // below is block-structured, so the 4 x 4 products are never formed):

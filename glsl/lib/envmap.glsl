@@ -4,13 +4,18 @@
 // u = atan2(z, x) / 2π + 1/2, v = θ / π from +y; the table holds the marginal
 // CDF (H + 1 entries) then each row's conditional CDF (W + 1 entries).
 //
-// The including shader defines, before including this file:
-//   float envCdfAt(uint i);         // entry i of the table
-//   vec3 envTexelRadiance(ivec2 t); // radiance of texel t (scale applied)
+// The including shader defines the two functions declared below (where the
+// table and the texels live differ by pass: the render pass's buffer and
+// texture array, the CPU-twin test's buffers).
 #ifndef ENVMAP_GLSL
 #define ENVMAP_GLSL
 
 #include "lights.glsl"
+
+// Entry i of the sampling table.
+float envCdfAt(uint i);
+// The radiance of texel t (scale applied).
+vec3 envTexelRadiance(ivec2 t);
 
 // θ from atan(sin θ, cos θ): GLSL's acos is far less accurate (errors
 // near 1e-4 rad were measured on lavapipe).

@@ -4,8 +4,12 @@
 #ifndef LIGHT_QUERIES_GLSL
 #define LIGHT_QUERIES_GLSL
 
+#include "intersect.glsl"
 #include "lights.glsl"
 #include "frame.glsl"
+
+// The scene's lights (Light in gpu_structs.glsl; frame.lightCount of them).
+layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
 
 // The first area light other than `except` that o + t d meets before tmax:
 // its index (or frame.lightCount when none) and distance.

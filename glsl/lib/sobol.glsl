@@ -14,7 +14,10 @@
 #ifndef SOBOL_GLSL
 #define SOBOL_GLSL
 
+#extension GL_EXT_control_flow_attributes : require
+
 #include "random.glsl"
+#include "spec_constants.glsl"
 
 struct SobolSampler {
     uint seed;       // the pixel's scrambling seed
@@ -67,8 +70,8 @@ vec2 sobolSample2(inout SobolSampler s) {
 // The path tracer's samples (render.glsl): SAMPLER_SOBOL takes each
 // decision's numbers from the Sobol points above, SAMPLER_INDEPENDENT from
 // one random generator per pixel and sample (random.glsl), drawn in the
-// order of the path's decisions (src/passes/variant.rs, SamplerMode).
-layout(constant_id = SPEC_SAMPLER) const uint SAMPLER = SAMPLER_SOBOL;
+// order of the path's decisions (src/passes/variant.rs, SamplerMode), by
+// SAMPLER (spec_constants.glsl).
 
 struct PathSampler {
     uint rng;

@@ -6,10 +6,12 @@
 // transmission pushes the material (entering) or removes it (leaving). This
 // is right for properly nested objects (a bubble in glass, water in a glass
 // vessel); coincident or overlapping interfaces would need priorities
-// (Schmidt & Budge 2002). Paths start in vacuum (index 1). Needs the
-// `materials` buffer declared before inclusion.
+// (Schmidt & Budge 2002). Paths start in vacuum (index 1).
 #ifndef STACK_GLSL
 #define STACK_GLSL
+
+#include "materials.glsl"
+#include "frame.glsl"
 
 const uint MEDIA_STACK = 4u;
 

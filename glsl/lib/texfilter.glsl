@@ -2,10 +2,12 @@
 // (u, v), given by its two semi-axes (1σ). Two lookups: probes along the
 // major axis (probeLookup, the default: Feline's fixed probes, or one at a
 // random place for a short footprint in a render) and elliptical weighted
-// averaging (ewaLookup, the reference), both with a bounded anisotropy. The
-// including shader declares `sampler2D textures[]` first.
+// averaging (ewaLookup, the reference), both with a bounded anisotropy.
 #ifndef TEXFILTER_GLSL
 #define TEXFILTER_GLSL
+
+#include "common.glsl"
+#include "texture_maps.glsl"
 
 struct Footprint {
     vec2 uv;

@@ -3,6 +3,8 @@
 #ifndef CAMERA_GLSL
 #define CAMERA_GLSL
 
+#include "render_inputs.glsl"
+
 // ---- The pixel filter -----------------------------------------------------
 // One pixel filter for every mode and for the reference: a Gaussian of
 // σ = frame.pixelSigma pixels (PIXEL_FILTER_SIGMA, src/passes/render.rs),

@@ -4,6 +4,8 @@
 #ifndef ENVIRONMENT_GLSL
 #define ENVIRONMENT_GLSL
 
+#include "render_inputs.glsl"
+
 // ---- The environment map --------------------------------------------------
 layout(set = 0, binding = BINDING_ENV_CDF, scalar) readonly buffer EnvCdf { float envCdf[]; };
 

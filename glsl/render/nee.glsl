@@ -4,6 +4,12 @@
 #ifndef NEE_GLSL
 #define NEE_GLSL
 
+#include "render_inputs.glsl"
+#include "light_queries.glsl"
+#include "environment.glsl"
+#include "path_record.glsl"
+#include "shadow_queue.glsl"
+
 bool environmentLit() { return frame.envMap != NO_TEXTURE || any(greaterThan(frame.background, vec3(0.0))); }
 
 // Light index `frame.lightCount` stands for the uniform environment (the
@@ -17,7 +23,6 @@ float lightOrEnvironmentPdf(uint i, vec3 x, vec3 wi) {
     return i == frame.lightCount ? environmentPdf(wi) : lightPdf(lights[i], x, wi);
 }
 
-#include "light_queries.glsl"
 
 // Number of light-sampling choices: the lights, plus the environment.
 uint lightChoices() { return frame.lightCount + (environmentLit() ? 1u : 0u); }

@@ -5,6 +5,14 @@
 #ifndef PATH_EVENTS_GLSL
 #define PATH_EVENTS_GLSL
 
+#include "render_inputs.glsl"
+#include "pass_inputs.glsl"
+#include "path_state.glsl"
+#include "shadow_queue.glsl"
+#include "nee.glsl"
+#include "roulette.glsl"
+#include "surface.glsl"
+
 // Shadow ray `sr`, queued by next-event estimation, came back with hit `h`:
 // what it brings counts if nothing blocks it.
 void shadowRayAnswered(inout PathState s, ShadowRay sr, SceneHit h) {

@@ -12,8 +12,10 @@
 // spread by their exact mean curvature. A rough or diffuse lobe does not
 // widen it: the lobe is sampled, and counting its bandwidth in the
 // footprint as well would filter twice.
-// Needs: covariance.glsl, hit.glsl (shapeOperator), frame.glsl and the
-// FILTER_MODE specialisation constant.
+#ifndef PATH_FOOTPRINT_GLSL
+#define PATH_FOOTPRINT_GLSL
+
+#include "render_inputs.glsl"
 
 struct PathFootprint {
     float coneWidth;     // σ of the cone's width at the ray's origin
@@ -135,3 +137,5 @@ void footprintBounce(inout PathFootprint f, HitFootprint hf, SceneHit h, vec3 d,
         f.coneWidth = hf.width;
     }
 }
+
+#endif

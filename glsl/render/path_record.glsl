@@ -4,13 +4,10 @@
 #ifndef PATH_RECORD_GLSL
 #define PATH_RECORD_GLSL
 
-#include "gpu_structs.glsl"
+#include "render_inputs.glsl"
 
-// Specialisation constant: 1 records every event of the path into `path`
-// (one pixel and one sample per dispatch: the outlier report's); 0 compiles
-// the recording out.
-layout(constant_id = SPEC_RECORD_PATH) const uint RECORD_PATH = 0u;
-
+// RECORD_PATH (spec_constants.glsl): 1 records every event of the path
+// into `path`; 0 compiles the recording out.
 layout(set = 0, binding = BINDING_RENDER_PATH, scalar) buffer PathRecordBuffer { PathRecord path; };
 
 // The footprint that the next record() stores (a surface event's, set by

@@ -3,6 +3,12 @@
 #ifndef PATH_STATE_GLSL
 #define PATH_STATE_GLSL
 
+#include "render_inputs.glsl"
+#include "stack.glsl"
+#include "path_footprint.glsl"
+#include "camera.glsl"
+#include "roulette.glsl"
+
 // A scattering event in a medium, for the weight of a positional light that
 // the sampled direction reaches: the segment it was on (origin, end
 // distance; direction), where on it, and the density σ_t T(t) there.

@@ -4,6 +4,9 @@
 #ifndef PIXEL_GLSL
 #define PIXEL_GLSL
 
+#include "render.glsl"
+#include "camera.glsl"
+
 // The AOVs of the ray through the pixel centre (depth, normal, albedo,
 // object), with no denoiser features yet.
 Aov pixelCentreAov(uvec2 pix) {

@@ -3,7 +3,7 @@
 // workgroup per RENDER_GROUP² block of the tile, blocks in a balanced order
 // (balance.glsl).
 #include "loop_budget.glsl"
-#include "render.glsl"
+#include "pixel.glsl"
 #include "balance.glsl"
 
 layout(local_size_x = RENDER_GROUP, local_size_y = RENDER_GROUP) in;

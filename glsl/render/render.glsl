@@ -3,79 +3,19 @@
 // tile, a path traced from the camera with next-event estimation and
 // multiple importance sampling (power heuristic) at every non-specular
 // vertex, Russian roulette after RR_DEPTH bounces, and at most `maxDepth`
-// bounces (1 = direct lighting only). Here: the pass's bindings and the
-// path loop (tracePath); around it, one idea a file: pass_inputs.glsl (the
+// bounces (1 = direct lighting only). Here: the path loop (tracePath); the
+// pass's bindings and push block in render_inputs.glsl, which each part
+// includes first; around it, one idea a file: pass_inputs.glsl (the
 // caustic, volume and beam passes' results), environment.glsl, surface.glsl
 // (textured materials), path_record.glsl, camera.glsl (pixel filter),
 // shadow_queue.glsl, nee.glsl (light sampling), roulette.glsl,
 // path_state.glsl (what a path carries), path_events.glsl (shadow rays,
-// media, emitters), surface_vertex.glsl and pixel.glsl (one sample).
+// media, emitters), surface_vertex.glsl, and pixel.glsl (one sample; it
+// includes this file, and the entry points include it).
 #ifndef RENDER_GLSL
 #define RENDER_GLSL
-#extension GL_EXT_nonuniform_qualifier : require
-
-#include "intersect.glsl"
-#include "random.glsl"
-#include "sobol.glsl"
-#include "lights.glsl"
-#include "uv.glsl"
-
-layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials { Material materials[]; };
-layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
-
-#include "frame.glsl"
-
-// rgb: summed radiance, a: sample count.
-layout(set = 0, binding = BINDING_ACCUM, rgba32f) uniform image2D accum;
-
-// The pixel-centre ray's AOVs (first sample) and the denoiser's feature
-// sums (every sample).
-layout(set = 0, binding = BINDING_AOV, scalar) buffer Aovs { Aov aovs[]; };
-
-// Texture maps with their mip chains (unused slots hold a white texel).
-layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTURES];
-
-vec4 mapAt(uint index, vec2 uv) { return textureLod(textures[nonuniformEXT(index)], uv, 0.0); }
-
-#include "texfilter.glsl"
-
-#include "covariance.glsl"
-
-// Specialisation constant: 1 when the scene has a participating medium (the
-// fog or a dielectric's interior); 0 compiles the media code out.
-layout(constant_id = SPEC_MEDIA_ENABLED) const uint MEDIA_ENABLED = 0u;
-
+#include "render_inputs.glsl"
 #include "pass_inputs.glsl"
-
-// Specialisation constant: FILTER_NONE, FILTER_RAY_CONES or FILTER_COVARIANCE.
-layout(constant_id = SPEC_FILTER_MODE) const uint FILTER_MODE = FILTER_NONE;
-// Specialisation constant: LOOKUP_PROBES (trilinear probes, the default) or
-// LOOKUP_EWA (the reference lookup), for the filtered modes.
-layout(constant_id = SPEC_LOOKUP_MODE) const uint LOOKUP_MODE = LOOKUP_PROBES;
-
-#include "path_footprint.glsl"
-
-#include "environment.glsl"
-#include "surface.glsl"
-layout(push_constant, scalar) uniform PushBlock { RenderPush pc; };
-
-// The largest single sample per pixel: r its luminance, g the sample index
-// that brought it (exact up to 2^24 samples). The outlier report
-// (src/passes/outliers.rs) compares it with the bound the scene allows.
-layout(set = 0, binding = BINDING_RENDER_MAX_SAMPLE, rg32f) uniform image2D maxSample;
-
-#include "path_record.glsl"
-// Specialisation constant: SHADING_FULL, SHADING_ALBEDO (the first hit's
-// albedo: no light sampling, no bounces; benchmark breakdowns) or
-// SHADING_MIRRORED_ALBEDO (the albedo seen through perfect mirrors; tests).
-layout(constant_id = SPEC_SHADING_MODE) const uint SHADING_MODE = SHADING_FULL;
-
-#include "camera.glsl"
-#include "shadow_queue.glsl"
-#include "nee.glsl"
-#include "roulette.glsl"
-#include "stack.glsl"
-
 #include "path_state.glsl"
 #include "path_events.glsl"
 #include "surface_vertex.glsl"
@@ -183,6 +123,5 @@ vec3 tracePath(vec3 o, vec3 d, uint pixel, inout PathSampler rng, out DenoiseFea
     return s.radiance;
 }
 
-#include "pixel.glsl"
 
 #endif

@@ -3,6 +3,9 @@
 #ifndef ROULETTE_GLSL
 #define ROULETTE_GLSL
 
+#include "render_inputs.glsl"
+#include "path_record.glsl"
+
 // Bounces after which Russian roulette may end a path.
 const uint RR_DEPTH = 3u;
 

@@ -3,6 +3,10 @@
 #ifndef SHADOW_QUEUE_GLSL
 #define SHADOW_QUEUE_GLSL
 
+#include "render_inputs.glsl"
+#include "light_queries.glsl"
+#include "path_record.glsl"
+
 // Shadow rays are not traced where next-event estimation makes them: they
 // wait in this queue and tracePath traces them at the same call site as
 // its own rays. Every call site of the intersection code is a full copy of

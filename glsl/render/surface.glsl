@@ -5,6 +5,9 @@
 #ifndef SURFACE_GLSL
 #define SURFACE_GLSL
 
+#include "render_inputs.glsl"
+#include "path_footprint.glsl"
+
 // A texture lookup over a footprint; FILTER_NONE ignores the footprint.
 vec4 lookup(uint index, Footprint fp) {
     if (FILTER_MODE == FILTER_NONE) return mapAt(index, fp.uv);

@@ -4,6 +4,14 @@
 #ifndef SURFACE_VERTEX_GLSL
 #define SURFACE_VERTEX_GLSL
 
+#include "render_inputs.glsl"
+#include "pass_inputs.glsl"
+#include "path_state.glsl"
+#include "path_events.glsl"
+#include "surface.glsl"
+#include "nee.glsl"
+#include "roulette.glsl"
+
 // The test and benchmark shading modes (SPEC_SHADING_MODE), which end a
 // path at a surface with an albedo instead of shading it: SHADING_ALBEDO at
 // the first hit, SHADING_MIRRORED_ALBEDO at the first surface that is not a

@@ -23,6 +23,7 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 
 #include "render.glsl"
+#include "pixel.glsl"
 
 // Slots in a wave: one per pixel of the largest tile.
 const uint WAVE_SLOTS = RENDER_TILE * RENDER_TILE;

@@ -6,14 +6,12 @@
 
 #include "intersect.glsl"
 
-
-
 layout(set = 0, binding = BINDING_PROBE_RAYS, scalar) readonly buffer Rays { Ray rays[]; };
 layout(set = 0, binding = BINDING_PROBE_HITS, scalar) writeonly buffer Hits { Hit hits[]; };
 
-// Specialisation constant: 1 to write the curvatures (the geometry tests),
-// 0 to skip their Hessian (the ray benchmark times intersection alone).
-layout(constant_id = SPEC_PROBE_CURVATURE) const uint PROBE_CURVATURE = 1u;
+// PROBE_CURVATURE: 1 to write the curvatures (the geometry tests), 0 to
+// skip their Hessian (the ray benchmark times intersection alone).
+#include "spec_constants.glsl"
 
 layout(push_constant, scalar) uniform PushBlock { ProbePush pc; };
 

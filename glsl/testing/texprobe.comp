@@ -10,14 +10,8 @@
 
 layout(local_size_x = PROBE_GROUP) in;
 
-layout(set = 0, binding = BINDING_TEXTURES) uniform sampler2D textures[MAX_TEXTURES];
-
+#include "spec_constants.glsl"
 #include "texfilter.glsl"
-
-// Specialisation constant: LOOKUP_PROBES or LOOKUP_EWA.
-layout(constant_id = SPEC_LOOKUP_MODE) const uint LOOKUP_MODE = LOOKUP_EWA;
-
-
 
 layout(set = 0, binding = BINDING_TEXPROBE_QUERIES, scalar) readonly buffer TexQueries { TexQuery queries[]; };
 layout(set = 0, binding = BINDING_TEXPROBE_RESULTS, scalar) writeonly buffer TexResults { TexResult results[]; };

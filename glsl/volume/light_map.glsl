@@ -20,8 +20,17 @@
 // 2014 (an omnidirectional shadow map as in Engelhardt & Dachsbacher,
 // "Octahedron Environment Maps", 2008).
 
-#include "random.glsl"
+#extension GL_EXT_scalar_block_layout : require
 
+#include "random.glsl"
+#include "frame.glsl"
+#include "light_queries.glsl"
+
+// The includer may qualify the maps' access (the light-map pass writes
+// them, the volume pass reads them); unqualified by default.
+#ifndef LIGHT_MAPS_ACCESS
+#define LIGHT_MAPS_ACCESS
+#endif
 layout(set = 0, binding = BINDING_LIGHT_MAPS, scalar) LIGHT_MAPS_ACCESS buffer LightMaps { float lightMaps[]; };
 
 // The unit vector w as a point of [0, 1]².

@@ -7,9 +7,7 @@
 
 #include "intersect.glsl"
 #include "lights.glsl"
-
-layout(set = 0, binding = BINDING_MATERIALS, scalar) readonly buffer Materials { Material materials[]; };
-layout(set = 0, binding = BINDING_LIGHTS, scalar) readonly buffer Lights { Light lights[]; };
+#include "materials.glsl"
 
 #include "frame.glsl"
 #include "light_queries.glsl"

@@ -43,25 +43,57 @@ pub const BINDING_TWIN_RESULTS: u32 = 24;
 pub const BINDING_TWIN_ENV_TABLE: u32 = 25;
 /// Descriptor binding of the environment texels (CPU-twin pass).
 pub const BINDING_TWIN_ENV_TEXELS: u32 = 26;
-/// Specialisation constant id: intersection mode (INTERSECT_*).
+/// Specialisation constant id: intersection mode, for cost breakdowns
+/// (benchmarks): INTERSECT_FULL, INTERSECT_BOXES (each candidate box reports
+/// a hit where the ray enters it: traversal cost only) or INTERSECT_BASE
+/// (perturbations ignored: the base quadric's roots in each box).
+/// Shaders' default: `INTERSECT_FULL`.
 pub const SPEC_INTERSECT_MODE: u32 = 0;
-/// Specialisation constant id: shading mode (SHADING_*).
+/// Specialisation constant id: shading mode: SHADING_FULL, SHADING_ALBEDO
+/// (the first hit's albedo: no light sampling, no bounces; benchmark
+/// breakdowns) or SHADING_MIRRORED_ALBEDO (the albedo seen through perfect
+/// mirrors; tests).
+/// Shaders' default: `SHADING_FULL`.
 pub const SPEC_SHADING_MODE: u32 = 1;
-/// Specialisation constant id: texture filtering mode (FILTER_*).
+/// Specialisation constant id: texture filtering mode: FILTER_NONE,
+/// FILTER_RAY_CONES or FILTER_COVARIANCE.
+/// Shaders' default: `FILTER_NONE`.
 pub const SPEC_FILTER_MODE: u32 = 2;
-/// Specialisation constant id: 1 when the scene has participating media.
+/// Specialisation constant id: 1 when the scene has a participating medium
+/// (the fog or a dielectric's interior); 0 compiles the media code out.
+/// Shaders' default: `0u`.
 pub const SPEC_MEDIA_ENABLED: u32 = 3;
-/// Specialisation constant id: 1 when the caustic passes ran.
+/// Specialisation constant id: 1 when the caustic passes ran: the diffuse
+/// vertices the caustic map covers read it, and the paths it covers are left
+/// out (see "caustic paths" in render.glsl); 0 compiles this out.
+/// Shaders' default: `0u`.
 pub const SPEC_CAUSTICS_ENABLED: u32 = 4;
-/// Specialisation constant id: 1 when the volume pass ran.
+/// Specialisation constant id: 1 when the volume pass ran: the camera ray's
+/// first segment gets its in-scattered light from it, and leaves single
+/// scattering toward positional lights out of its own estimate; 0 compiles
+/// this out.
+/// Shaders' default: `0u`.
 pub const SPEC_VOLUME_ENABLED: u32 = 5;
-/// Specialisation constant id: 1 when the caustic beams ran.
+/// Specialisation constant id: 1 when the caustic beam pass ran (caustics in
+/// fog): the camera ray's first segment gets the volumetric caustics from the
+/// beam map, and a path that scatters on it and reaches a sphere light
+/// through the specular vertices the caustic rays follow is left out.
+/// Shaders' default: `0u`.
 pub const SPEC_BEAMS_ENABLED: u32 = 6;
-/// Specialisation constant id: 1 to record one pixel's path.
+/// Specialisation constant id: 1 records every event of one pixel's path
+/// (one pixel and one sample per dispatch: the outlier report's); 0 compiles
+/// the recording out.
+/// Shaders' default: `0u`.
 pub const SPEC_RECORD_PATH: u32 = 7;
-/// Specialisation constant id: texture lookup mode (LOOKUP_*).
+/// Specialisation constant id: texture lookup mode of the filtered modes:
+/// LOOKUP_PROBES (trilinear probes, the default) or LOOKUP_EWA (the
+/// reference lookup).
+/// Shaders' default: `LOOKUP_PROBES`.
 pub const SPEC_LOOKUP_MODE: u32 = 8;
-/// Specialisation constant id: 1 when the probe pass computes curvatures.
+/// Specialisation constant id: 1 when the probe pass computes curvatures
+/// (the geometry tests), 0 to skip their Hessian (the ray benchmark times
+/// intersection alone).
+/// Shaders' default: `1u`.
 pub const SPEC_PROBE_CURVATURE: u32 = 9;
 /// Descriptor binding of the texture array (render pass).
 pub const BINDING_TEXTURES: u32 = 10;
@@ -195,13 +227,16 @@ pub const BINDING_RENDER_PATH: u32 = 17;
 pub const BINDING_LOOP_BUDGET: u32 = 30;
 /// Specialisation constant id: 1 to measure the loop budget each tracing
 /// invocation leaves (glsl/intersection/loop_budget.glsl; off in renders).
+/// Shaders' default: `0u`.
 pub const SPEC_LOOP_BUDGET: u32 = 10;
 /// Specialisation constant id: 0 when no ray of the scene can start beyond
 /// an object's rebase distance (`GpuScene::far_rays`), which leaves the
 /// far-ray search (glsl/intersection/root_search.glsl, candidateFirstRoot) and its
 /// per-candidate test out of the shaders; 1 (the default) keeps them.
+/// Shaders' default: `1u`.
 pub const SPEC_FAR_RAYS: u32 = 11;
 /// Specialisation constant id: the path tracer's samples (SAMPLER_*).
+/// Shaders' default: `SAMPLER_SOBOL`.
 pub const SPEC_SAMPLER: u32 = 12;
 /// Sampler: independent random numbers per decision (glsl/lib/random.glsl).
 pub const SAMPLER_INDEPENDENT: u32 = 0;
