@@ -30,23 +30,17 @@ Usage: pip install mitsuba==3.9.1; apt-get install libllvm19; cargo build --rele
   python3 scripts/mitsuba_side_by_side.py [--quadray target/release/quadray] [--out results/mitsuba]
 """
 
-import argparse
 import json
 import os
 import re
 import subprocess
+import sys
 import time
 
-# Dr.Jit JIT-compiles through the system's libLLVM; Debian 12's LLVM 15
-# aborts on Mitsuba 3.9's kernels ("Cannot select: fminimum"), LLVM 19
-# (`apt-get install libllvm19`) works.
-LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
-if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LLVM19):
-    os.environ["DRJIT_LIBLLVM_PATH"] = LLVM19
+sys.path.insert(0, os.path.dirname(__file__))
+from mitsuba_scene import arguments, relmse  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
-
-mi.set_variant("llvm_ad_rgb")
 from mitsuba import ScalarTransform4f as T  # noqa: E402
 
 
@@ -129,21 +123,11 @@ def quadray_render(quadray, path, width, height, spp, seed, bench=False):
     return None
 
 
-def relmse(quadray, reference, test):
-    out = subprocess.run([quadray, "compare", reference, test], check=True, capture_output=True, text=True).stdout
-    return float(re.search(r"relative MSE ([0-9.eE+-]+)", out).group(1))
-
-
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--quadray", default="target/release/quadray")
-    ap.add_argument("--out", default="results/mitsuba")
-    ap.add_argument("--width", type=int, default=1024)
-    ap.add_argument("--height", type=int, default=768)
+    ap = arguments(__doc__, "results/mitsuba", 1024, 768, 1024)
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--err-width", type=int, default=512)
     ap.add_argument("--err-height", type=int, default=384)
-    ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--seeds", type=int, default=4)
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)

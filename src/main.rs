@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 
 use cli::bench::*;
 use cli::devices::*;
+use cli::export::*;
 use cli::farm::*;
 use cli::images::*;
 use cli::render::*;
@@ -87,6 +88,12 @@ enum Command {
     /// (`--baseline`) in the same run; writes throughput.json and
     /// throughput.md.
     Throughput(ThroughputArgs),
+    /// Export a scene for other renderers: each object as a triangle mesh
+    /// (PLY in world space with normals and texture coordinates; surface
+    /// nets projected onto the exact surface, cut by the clip box), each
+    /// texture map as EXR, and the resolved scene as scene.json (used by
+    /// scripts/mitsuba_side_by_side.py).
+    Export(ExportArgs),
 }
 
 /// The threads lavapipe runs compute dispatches on, when the user has not
@@ -170,6 +177,7 @@ fn run() -> Result<()> {
         Some(Command::Denoise(args)) => denoise(args),
         Some(Command::Farm(cmd)) => farm(cmd),
         Some(Command::Devices(args)) => devices(args),
+        Some(Command::Export(args)) => export(args),
         None => {
             // Bare `quadray`: the usage, as pbrt and Mitsuba print theirs.
             use clap::CommandFactory;

@@ -4,6 +4,7 @@
 pub(crate) mod bench;
 pub(crate) mod common;
 pub(crate) mod devices;
+pub(crate) mod export;
 pub(crate) mod farm;
 pub(crate) mod images;
 pub(crate) mod render;

@@ -7,6 +7,7 @@
 mod common;
 
 mod commands;
+mod export;
 mod farm_slurm;
 mod long_renders;
 mod runtime;

@@ -3,6 +3,7 @@
 //! structure, and the reference ray intersection that the GPU is tested
 //! against.
 
+pub mod mesh;
 pub mod object;
 pub mod poly;
 pub mod quadric;

@@ -1,0 +1,276 @@
+"""A quadray scene as a Mitsuba 3 scene dictionary (issue 44).
+
+`quadray export SCENE -o DIR` writes DIR/scene.json (the resolved scene),
+DIR/object-N.ply (each functional object as a mesh in world space, with
+normals and texture coordinates) and DIR/texture-N.exr (each texture map,
+level 0, linear, row 0 at v = 0); `mitsuba_dict(DIR, ...)` turns them into
+the scene Mitsuba's `load_dict` takes, with the same camera, pixel filter,
+path length, materials and lights, so that both renderers converge to the
+same image (up to the mesh's chordal error).
+
+Covered: diffuse (albedo times its map), mirror, conductor (exact complex
+Fresnel, smooth or GGX), dielectric (smooth or GGX) surfaces, nested
+dielectrics (each one's outside is the smallest dielectric whose box holds
+it: water in a glass's cavity), emission, albedo maps; point, sphere, rect
+and directional lights; the uniform background; homogeneous media (the fog
+around everything, a dielectric's interior) with a Henyey-Greenstein phase
+function, for Mitsuba's `volpath`. Anything else (normal, roughness and
+displacement maps, Schlick conductors, environment maps) raises
+`Unsupported`: a comparison must not run on a scene Mitsuba would render
+differently.
+"""
+
+import argparse
+import json
+import os
+import re
+import subprocess
+
+# Dr.Jit JIT-compiles through the system's libLLVM; Debian 12's LLVM 15
+# aborts on Mitsuba 3.9's kernels ("Cannot select: fminimum"), LLVM 19
+# (`apt-get install libllvm19`) works.
+LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
+if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LLVM19):
+    os.environ["DRJIT_LIBLLVM_PATH"] = LLVM19
+
+import mitsuba as mi  # noqa: E402
+
+mi.set_variant("llvm_ad_rgb")
+
+
+def arguments(doc, out, width, height, ref_spp):
+    """The flags both side-by-side scripts take, with their defaults."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quadray", default="target/release/quadray")
+    ap.add_argument("--out", default=out)
+    ap.add_argument("--width", type=int, default=width)
+    ap.add_argument("--height", type=int, default=height)
+    ap.add_argument("--ref-spp", type=int, default=ref_spp)
+    return ap
+
+
+def compare(quadray, reference, test):
+    """relMSE on linear radiance and mean FLIP of EXR `test` against EXR
+    `reference` (`quadray compare`)."""
+    out = subprocess.run([quadray, "compare", reference, test], check=True, capture_output=True, text=True).stdout
+    flip = float(re.search(r"FLIP ([0-9.eE+-]+)", out).group(1))
+    return float(re.search(r"relative MSE ([0-9.eE+-]+)", out).group(1)), flip
+
+
+def relmse(quadray, reference, test):
+    """relMSE of EXR `test` against EXR `reference` on linear radiance."""
+    return compare(quadray, reference, test)[0]
+
+
+class Unsupported(Exception):
+    """A scene feature the conversion does not express exactly."""
+
+
+def rgb(v):
+    return {"type": "rgb", "value": [float(x) for x in v]}
+
+
+def _texture(exported, index, dir_):
+    t = exported["textures"][index]
+    return {
+        "type": "bitmap",
+        "filename": os.path.join(dir_, t["file"]),
+        "raw": True,
+        "filter_type": "bilinear",
+        "wrap_mode": "repeat",
+    }
+
+
+def _bsdf(material, exported, dir_, ext_ior=1.0):
+    maps = material["maps"]
+    for key in ("normal", "roughness", "displacement"):
+        if maps.get(key) is not None:
+            raise Unsupported(f"material {material['name']}: a {key} map")
+    kind = material["kind"]
+    albedo = material["albedo"]
+    if kind == "Diffuse":
+        if maps.get("albedo") is not None:
+            reflectance = _texture(exported, maps["albedo"], dir_)
+            if any(abs(a - 1.0) > 0 for a in albedo):
+                # quadray multiplies the map by the albedo; Mitsuba's bitmap
+                # has no tint, so bake it into a copy of the map.
+                reflectance = _tinted(reflectance, albedo, dir_, maps["albedo"])
+        else:
+            reflectance = rgb(albedo)
+        return {"type": "diffuse", "reflectance": reflectance}
+    if kind == "Mirror":
+        return {"type": "conductor", "material": "none", "specular_reflectance": rgb(albedo)}
+    if "Conductor" in kind:
+        c = kind["Conductor"]
+        fresnel = c["fresnel"]
+        if "Complex" not in fresnel:
+            raise Unsupported(f"material {material['name']}: a Schlick conductor")
+        eta, k = fresnel["Complex"]["eta"], fresnel["Complex"]["k"]
+        if c["roughness"] == 0:
+            return {"type": "conductor", "eta": rgb(eta), "k": rgb(k)}
+        return {"type": "roughconductor", "eta": rgb(eta), "k": rgb(k), "distribution": "ggx",
+                "alpha": float(c["roughness"]) ** 2, "sample_visible": True}
+    if "Dielectric" in kind:
+        d = kind["Dielectric"]
+        if d["roughness"] == 0:
+            return {"type": "dielectric", "int_ior": float(d["ior"]), "ext_ior": ext_ior}
+        return {"type": "roughdielectric", "int_ior": float(d["ior"]), "ext_ior": ext_ior, "distribution": "ggx",
+                "alpha": float(d["roughness"]) ** 2, "sample_visible": True}
+    raise Unsupported(f"material {material['name']}: kind {kind}")
+
+
+def _tinted(texture, albedo, dir_, index):
+    path = os.path.join(dir_, f"texture-{index}-tinted.exr")
+    if not os.path.exists(path):
+        import numpy as np
+
+        image = np.array(mi.Bitmap(texture["filename"]))
+        image[..., :3] *= np.array(albedo, dtype=image.dtype)
+        mi.Bitmap(image).write(path)
+    return dict(texture, filename=path)
+
+
+def _rect_transform(light):
+    import numpy as np
+
+    c = np.array(light["corner"], float)
+    u = np.array(light["edge_u"], float)
+    v = np.array(light["edge_v"], float)
+    n = np.cross(u, v)
+    n /= np.linalg.norm(n)
+    centre = c + 0.5 * (u + v)
+    m = np.identity(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = 0.5 * u, 0.5 * v, n, centre
+    return mi.ScalarTransform4f(m.tolist())
+
+
+def mitsuba_dict(dir_, width, height, spp, seed, integrator="path"):
+    """The exported scene in `dir_` as a Mitsuba scene dictionary."""
+    with open(os.path.join(dir_, "scene.json")) as f:
+        exported = json.load(f)
+    if exported.get("environment") is not None:
+        raise Unsupported("an environment map")
+    image, camera = exported["image"], exported["camera"]
+    scene = {
+        "type": "scene",
+        # quadray's max_depth counts bounces; Mitsuba's counts segments.
+        "integrator": {"type": integrator, "max_depth": int(image["max_depth"]) + 1},
+        "sensor": {
+            "type": "perspective",
+            "fov": float(camera["vfov_degrees"]),
+            "fov_axis": "y",
+            "to_world": mi.ScalarTransform4f().look_at(origin=camera["position"], target=camera["look_at"],
+                                                       up=camera["up"]),
+            "film": {
+                "type": "hdrfilm",
+                "width": width,
+                "height": height,
+                # quadray's pixel filter: a Gaussian of σ = 0.5 px
+                # (PIXEL_FILTER_SIGMA), drawn by jittering the camera rays;
+                # Mitsuba splats each sample with the same Gaussian. Both
+                # converge to the same filtered image.
+                "rfilter": {"type": "gaussian", "stddev": 0.5},
+                "pixel_format": "rgb",
+            },
+            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+        },
+    }
+    if any(b > 0 for b in exported["background"]):
+        scene["background"] = {"type": "constant", "radiance": rgb(exported["background"])}
+    materials = exported["materials"]
+    objects = exported["objects"]
+    fog = exported.get("fog")
+    media = any(m.get("medium") is not None for m in materials) or fog is not None
+    if media and integrator == "path":
+        scene["integrator"]["type"] = "volpath"
+    if fog is not None:
+        scene["fog"] = _medium(fog)
+        scene["sensor"]["medium"] = {"type": "ref", "id": "fog"}
+    parents = _dielectric_parents(objects, materials)
+    for i, o in enumerate(objects):
+        material = materials[o["material"]]
+        parent = parents.get(i)
+        ext_ior = 1.0 if parent is None else _ior(materials[objects[parent]["material"]])
+        bsdf = _bsdf(material, exported, dir_, ext_ior)
+        if _ior(material) is None:
+            # quadray's opaque surfaces scatter on both sides; Mitsuba's
+            # only on the normal's side unless wrapped.
+            bsdf = {"type": "twosided", "bsdf": bsdf}
+        shape = {
+            "type": "ply",
+            "filename": os.path.join(dir_, o["mesh"]),
+            "face_normals": False,
+            "bsdf": bsdf,
+        }
+        if any(e > 0 for e in material["emission"]):
+            shape["emitter"] = {"type": "area", "radiance": rgb(material["emission"])}
+        # The medium on each side: a dielectric's own inside (its
+        # material's medium, else none), outside the parent's inside or
+        # the fog; an opaque surface has the outside's on both.
+        outside = _inside_medium(scene, materials[objects[parent]["material"]], f"medium-{parent}") \
+            if parent is not None else ({"type": "ref", "id": "fog"} if fog is not None else None)
+        if outside is not None:
+            shape["exterior"] = outside
+        if _ior(material) is not None:
+            inside = _inside_medium(scene, material, f"medium-{i}")
+            if inside is not None:
+                shape["interior"] = inside
+        elif outside is not None:
+            shape["interior"] = outside
+        scene[f"object-{i}"] = shape
+    for i, light in enumerate(exported["lights"]):
+        (kind, p), = light.items()
+        if kind == "Point":
+            scene[f"light-{i}"] = {"type": "point", "position": p["position"], "intensity": rgb(p["intensity"])}
+        elif kind == "Sphere":
+            scene[f"light-{i}"] = {"type": "sphere", "center": p["centre"], "radius": float(p["radius"]),
+                                   "emitter": {"type": "area", "radiance": rgb(p["radiance"])}}
+        elif kind == "Rect":
+            scene[f"light-{i}"] = {"type": "rectangle", "to_world": _rect_transform(p),
+                                   "emitter": {"type": "area", "radiance": rgb(p["radiance"])}}
+        elif kind == "Directional":
+            scene[f"light-{i}"] = {"type": "directional", "direction": [-x for x in p["direction"]],
+                                   "irradiance": rgb(p["irradiance"])}
+        else:
+            raise Unsupported(f"light {kind}")
+        if fog is not None and kind in ("Sphere", "Rect"):
+            scene[f"light-{i}"]["exterior"] = {"type": "ref", "id": "fog"}
+    return scene
+
+
+def _medium(m):
+    """A quadray medium (density σ_t, single-scattering albedo, HG g)."""
+    return {"type": "homogeneous", "sigma_t": float(m["density"]), "albedo": rgb(m["albedo"]),
+            "phase": {"type": "hg", "g": float(m["anisotropy"])}}
+
+
+def _ior(material):
+    kind = material["kind"]
+    return float(kind["Dielectric"]["ior"]) if isinstance(kind, dict) and "Dielectric" in kind else None
+
+
+def _inside_medium(scene, material, name):
+    """A reference to the medium inside a dielectric (declared once), or None."""
+    if material.get("medium") is None:
+        return None
+    if name not in scene:
+        scene[name] = _medium(material["medium"])
+    return {"type": "ref", "id": name}
+
+
+def _dielectric_parents(objects, materials):
+    """For each dielectric object, the smallest dielectric object whose mesh's
+    box holds its own (what quadray's medium stack has around it)."""
+    def volume(b):
+        return (b[1][0] - b[0][0]) * (b[1][1] - b[0][1]) * (b[1][2] - b[0][2])
+
+    def holds(a, b):
+        return all(a[0][k] <= b[0][k] and b[1][k] <= a[1][k] for k in range(3)) and volume(a) > volume(b)
+
+    dielectric = [i for i, o in enumerate(objects) if _ior(materials[o["material"]]) is not None]
+    parents = {}
+    for i in dielectric:
+        around = [j for j in dielectric if j != i and holds(objects[j]["mesh_bounds"], objects[i]["mesh_bounds"])]
+        if around:
+            parents[i] = min(around, key=lambda j: volume(objects[j]["mesh_bounds"]))
+    return parents
