@@ -36,6 +36,11 @@ fn align_up(v: u64, a: u64) -> u64 {
 }
 
 impl AccelerationStructure {
+    /// A buffer holding a build's input (boxes or instances), readable by the build.
+    fn build_input(device: &Arc<Device>, name: &str, bytes: &[u8]) -> Result<Buffer, VkError> {
+        Buffer::with_data(device, name, bytes, vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR)
+    }
+
     fn build(
         device: &Arc<Device>,
         cmds: &mut Commands,
@@ -131,12 +136,7 @@ impl AccelerationStructure {
         let bytes = unsafe {
             std::slice::from_raw_parts(positions.as_ptr() as *const u8, std::mem::size_of_val(positions.as_slice()))
         };
-        let input = Buffer::with_data(
-            device,
-            "blas aabbs",
-            bytes,
-            vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR,
-        )?;
+        let input = Self::build_input(device, "blas aabbs", bytes)?;
         let data = vk::AccelerationStructureGeometryAabbsDataKHR::default()
             .data(vk::DeviceOrHostAddressConstKHR { device_address: input.device_address() })
             .stride(std::mem::size_of::<vk::AabbPositionsKHR>() as u64);
@@ -172,12 +172,7 @@ impl AccelerationStructure {
                 std::mem::size_of_val(raw_instances.as_slice()),
             )
         };
-        let input = Buffer::with_data(
-            device,
-            "tlas instances",
-            bytes,
-            vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR,
-        )?;
+        let input = Self::build_input(device, "tlas instances", bytes)?;
         let data = vk::AccelerationStructureGeometryInstancesDataKHR::default()
             .array_of_pointers(false)
             .data(vk::DeviceOrHostAddressConstKHR { device_address: input.device_address() });
