@@ -96,6 +96,14 @@ fn sampler(map: &EnvironmentMap) -> impl FnMut([f64; 3]) -> Option<DVec3> + '_ {
     |u| map.sample(u[0], u[1]).map(|s| s.0)
 }
 
+/// The chi-square test of `map`'s sampling against its own pdf, checked
+/// (passes at the level, ∫pdf dω = 1) under `name`.
+fn chi2_of_map(map: &EnvironmentMap, config: &Chi2Config, name: &str) -> Chi2Report {
+    let r = chi2_test(config, sampler(map), |d| map.pdf(d));
+    check(name, &r);
+    r
+}
+
 /// The smallest cos of the angle between `axis` and the corners and edge
 /// midpoints of texel (i, j) (a cap around `axis` down to it holds the texel
 /// when the texel is small and away from the poles).
@@ -117,8 +125,7 @@ fn cap_cos_around_texel(map: &EnvironmentMap, axis: DVec3, i: usize, j: usize) -
 fn chi2_procedural_sky() {
     let map = sky();
     let config = Chi2Config { axis: axis(0), seed: 101, ..Chi2Config::default() };
-    let r = chi2_test(&config, sampler(&map), |d| map.pdf(d));
-    check("sky 64x32, whole sphere", &r);
+    chi2_of_map(&map, &config, "sky 64x32, whole sphere");
 }
 
 /// The sun, finely binned: a 9.5° cap around it (the 2.5° disk and the four
@@ -147,8 +154,7 @@ fn chi2_procedural_sky_sun_cap() {
         seed: 102,
         ..Chi2Config::default()
     };
-    let r = chi2_test(&config, sampler(&map), |d| map.pdf(d));
-    check("sky 64x32 (pole rows black), 9.5° sun cap", &r);
+    chi2_of_map(&map, &config, "sky 64x32 (pole rows black), 9.5° sun cap");
 }
 
 #[test]
@@ -156,8 +162,7 @@ fn chi2_random_map() {
     let map = random_map();
     for k in 0..2 {
         let config = Chi2Config { axis: axis(k), seed: 201 + k as u64, ..Chi2Config::default() };
-        let r = chi2_test(&config, sampler(&map), |d| map.pdf(d));
-        check(&format!("random 16x8, axis {:.2}", axis(k)), &r);
+        chi2_of_map(&map, &config, &format!("random 16x8, axis {:.2}", axis(k)));
     }
 }
 
@@ -165,14 +170,12 @@ fn chi2_random_map() {
 fn chi2_single_texel() {
     let map = single_texel_map();
     let config = Chi2Config { axis: axis(1), seed: 301, ..Chi2Config::default() };
-    let r = chi2_test(&config, sampler(&map), |d| map.pdf(d));
-    check("single texel 16x8, whole sphere", &r);
+    chi2_of_map(&map, &config, "single texel 16x8, whole sphere");
     let (w, h) = (f64::from(map.width), f64::from(map.height));
     let axis = uv_to_direction((LIT.0 as f64 + 0.5) / w, (LIT.1 as f64 + 0.5) / h);
     let cap = cap_cos_around_texel(&map, axis, LIT.0, LIT.1) - 0.01;
     let config = Chi2Config { axis, cap_cos: cap, seed: 302, ..Chi2Config::default() };
-    let r = chi2_test(&config, sampler(&map), |d| map.pdf(d));
-    check("single texel 16x8, cap on the texel", &r);
+    let r = chi2_of_map(&map, &config, "single texel 16x8, cap on the texel");
     assert_eq!(r.zero_expected_hits, 0);
 }
 

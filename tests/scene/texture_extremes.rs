@@ -65,18 +65,26 @@ fn floor_scene(texture: quadray::model::scene::TextureImage) -> Scene {
     scene
 }
 
-/// Largest |albedo AOV − expected(uv)| over the floor's pixels, and how many
-/// were checked; `expected` may skip a pixel (None).
-fn worst_albedo_error(
+/// Checks that the largest |albedo AOV − expected(uv)| over the floor's
+/// pixels (`expected` may skip a pixel: None) is within `bound`, over more
+/// than 2000 pixels; prints it under `what` and returns it.
+fn assert_albedo_within(
     scene: &mut Scene,
     filter: FilterMode,
     expected: impl Fn(DVec2) -> Option<[f32; 3]>,
-) -> (f64, usize) {
+    bound: f64,
+    what: &str,
+) -> f64 {
     let (worst, checked) = worst_albedo_errors(scene, filter, expected);
-    (worst.into_iter().fold(0.0, f64::max), checked)
+    let worst = worst.into_iter().fold(0.0, f64::max);
+    println!("{what}, filter {filter}: {checked} pixels, worst albedo error {worst:.2e} (bound {bound:.0e})");
+    assert!(checked > 2000);
+    assert!(worst <= bound, "{what}, {filter}: {worst}");
+    worst
 }
 
-/// [`worst_albedo_error`] per channel.
+/// The largest |albedo AOV − expected(uv)| per channel over the floor's
+/// pixels, and how many were checked.
 fn worst_albedo_errors(
     scene: &mut Scene,
     filter: FilterMode,
@@ -115,10 +123,7 @@ fn a_one_texel_map_is_one_colour_at_every_footprint() {
     const BOUND: f64 = 1e-5;
     let mut scene = floor_scene(from_texels("1x1".into(), 1, 1, vec![[C[0], C[1], C[2], 1.0]]));
     for filter in FilterMode::ALL {
-        let (worst, checked) = worst_albedo_error(&mut scene, filter, |_| Some(C));
-        println!("1x1 map, filter {filter}: {checked} pixels, worst albedo error {worst:.2e} (bound {BOUND:.0e})");
-        assert!(checked > 2000);
-        assert!(worst <= BOUND, "{filter}: {worst}");
+        assert_albedo_within(&mut scene, filter, |_| Some(C), BOUND, "1x1 map");
     }
 }
 
@@ -141,13 +146,8 @@ fn a_16k_wide_ramp_is_read_exactly_at_every_footprint() {
     // grazing angles and are truncated to a tap budget, centred within 16
     // texels (0.1 % of the texture's width).
     for (filter, bound) in [(FilterMode::None, 1e-5), (FilterMode::RayCones, 1e-3), (FilterMode::Covariance, 1e-3)] {
-        let (worst, checked) = worst_albedo_error(&mut scene, filter, expected);
-        println!(
-            "16384 x 4 ramp, filter {filter}: {checked} pixels, worst albedo error {worst:.2e} ({:.2} texels; bound {bound:.0e})",
-            worst * (width - 1) as f64
-        );
-        assert!(checked > 2000);
-        assert!(worst <= bound, "{filter}: {worst}");
+        let worst = assert_albedo_within(&mut scene, filter, expected, bound, "16384 x 4 ramp");
+        println!("  ({:.2} texels of the ramp)", worst * (width - 1) as f64);
     }
 }
 
