@@ -10,14 +10,15 @@ same image (up to the mesh's chordal error).
 
 Covered: diffuse (albedo times its map), mirror, conductor (exact complex
 Fresnel, smooth or GGX), dielectric (smooth or GGX) surfaces, nested
-dielectrics (each one's outside is the smallest dielectric whose box holds
-it: water in a glass's cavity), emission, albedo maps; point, sphere, rect
-and directional lights; the uniform background; homogeneous media (the fog
-around everything, a dielectric's interior) with a Henyey-Greenstein phase
-function, for Mitsuba's `volpath`. Anything else (normal, roughness and
-displacement maps, Schlick conductors, environment maps) raises
-`Unsupported`: a comparison must not run on a scene Mitsuba would render
-differently.
+dielectrics (each object's outside is the smallest dielectric whose box
+holds it: water in a glass's cavity; an index-matched one is a null
+interface); point, sphere and directional lights; the uniform background;
+homogeneous media (the fog around everything, a dielectric's interior)
+with a Henyey-Greenstein phase function, for Mitsuba's `volpath`. Anything
+else (normal, roughness and displacement maps, maps on other materials,
+Schlick conductors, emissive surfaces and rect lights (quadray's emit or
+pass light on both sides), environment maps) raises `Unsupported`: a
+comparison must not run on a scene Mitsuba would render differently.
 """
 
 import argparse
@@ -88,6 +89,12 @@ def _bsdf(material, exported, dir_, ext_ior=1.0):
             raise Unsupported(f"material {material['name']}: a {key} map")
     kind = material["kind"]
     albedo = material["albedo"]
+    if maps.get("albedo") is not None and kind != "Diffuse":
+        raise Unsupported(f"material {material['name']}: an albedo map on a {kind if isinstance(kind, str) else next(iter(kind))}")
+    if any(e > 0 for e in material["emission"]):
+        # quadray's emissive surfaces emit on both sides, Mitsuba's area
+        # emitters on the normal's side.
+        raise Unsupported(f"material {material['name']}: emission")
     if kind == "Diffuse":
         if maps.get("albedo") is not None:
             reflectance = _texture(exported, maps["albedo"], dir_)
@@ -112,6 +119,9 @@ def _bsdf(material, exported, dir_, ext_ior=1.0):
                 "alpha": float(c["roughness"]) ** 2, "sample_visible": True}
     if "Dielectric" in kind:
         d = kind["Dielectric"]
+        if float(d["ior"]) == ext_ior:
+            # Index-matched: quadray passes straight through (not a bounce).
+            return {"type": "null"}
         if d["roughness"] == 0:
             return {"type": "dielectric", "int_ior": float(d["ior"]), "ext_ior": ext_ior}
         return {"type": "roughdielectric", "int_ior": float(d["ior"]), "ext_ior": ext_ior, "distribution": "ggx",
@@ -128,20 +138,6 @@ def _tinted(texture, albedo, dir_, index):
         image[..., :3] *= np.array(albedo, dtype=image.dtype)
         mi.Bitmap(image).write(path)
     return dict(texture, filename=path)
-
-
-def _rect_transform(light):
-    import numpy as np
-
-    c = np.array(light["corner"], float)
-    u = np.array(light["edge_u"], float)
-    v = np.array(light["edge_v"], float)
-    n = np.cross(u, v)
-    n /= np.linalg.norm(n)
-    centre = c + 0.5 * (u + v)
-    m = np.identity(4)
-    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = 0.5 * u, 0.5 * v, n, centre
-    return mi.ScalarTransform4f(m.tolist())
 
 
 def mitsuba_dict(dir_, width, height, spp, seed, integrator="path"):
@@ -202,8 +198,6 @@ def mitsuba_dict(dir_, width, height, spp, seed, integrator="path"):
             "face_normals": False,
             "bsdf": bsdf,
         }
-        if any(e > 0 for e in material["emission"]):
-            shape["emitter"] = {"type": "area", "radiance": rgb(material["emission"])}
         # The medium on each side: a dielectric's own inside (its
         # material's medium, else none), outside the parent's inside or
         # the fog; an opaque surface has the outside's on both.
@@ -226,8 +220,9 @@ def mitsuba_dict(dir_, width, height, spp, seed, integrator="path"):
             scene[f"light-{i}"] = {"type": "sphere", "center": p["centre"], "radius": float(p["radius"]),
                                    "emitter": {"type": "area", "radiance": rgb(p["radiance"])}}
         elif kind == "Rect":
-            scene[f"light-{i}"] = {"type": "rectangle", "to_world": _rect_transform(p),
-                                   "emitter": {"type": "area", "radiance": rgb(p["radiance"])}}
+            # quadray's rect light lets rays through from its back; a
+            # Mitsuba emitter shape blocks them.
+            raise Unsupported("a rect light (transparent from behind in quadray)")
         elif kind == "Directional":
             scene[f"light-{i}"] = {"type": "directional", "direction": [-x for x in p["direction"]],
                                    "irradiance": rgb(p["irradiance"])}
@@ -259,8 +254,8 @@ def _inside_medium(scene, material, name):
 
 
 def _dielectric_parents(objects, materials):
-    """For each dielectric object, the smallest dielectric object whose mesh's
-    box holds its own (what quadray's medium stack has around it)."""
+    """For each object, the smallest dielectric object whose mesh's box holds
+    its own (what quadray's medium stack has around it), if any."""
     def volume(b):
         return (b[1][0] - b[0][0]) * (b[1][1] - b[0][1]) * (b[1][2] - b[0][2])
 
@@ -269,7 +264,7 @@ def _dielectric_parents(objects, materials):
 
     dielectric = [i for i, o in enumerate(objects) if _ior(materials[o["material"]]) is not None]
     parents = {}
-    for i in dielectric:
+    for i in range(len(objects)):
         around = [j for j in dielectric if j != i and holds(objects[j]["mesh_bounds"], objects[i]["mesh_bounds"])]
         if around:
             parents[i] = min(around, key=lambda j: volume(objects[j]["mesh_bounds"]))

@@ -29,15 +29,17 @@ pub(crate) struct ExportArgs {
 /// `texture-N.exr`, level 0, linear values, row 0 at v = 0) and
 /// `object-N.ply` per object.
 pub(crate) fn export(args: ExportArgs) -> Result<()> {
-    let scene = read_scene(args.scene.as_deref())?;
+    let mut scene = read_scene(args.scene.as_deref())?;
     if args.output.is_file() {
         bail!("{} is a file: the output is a folder", args.output.display());
     }
     std::fs::create_dir_all(&args.output).with_context(|| format!("cannot create {}", args.output.display()))?;
+    // Texture maps go to EXR files (level 0); the JSON names them (taken out
+    // first: their mip chains would make a JSON tree of gigabytes).
+    let maps = std::mem::take(&mut scene.textures);
     let mut json = serde_json::to_value(&scene).context("cannot serialise the scene")?;
-    // Texture maps go to EXR files; the JSON names them.
     let mut textures = Vec::new();
-    for (i, t) in scene.textures.iter().enumerate() {
+    for (i, t) in maps.iter().enumerate() {
         let file = format!("texture-{i}.exr");
         let texels = &t.levels[0];
         let width = t.width as usize;

@@ -279,14 +279,16 @@ fn project(f: &Local, start: DVec3, reach: f64) -> (DVec3, bool) {
         }
         let step = g * (f.eval(p) / g2);
         p -= step;
-        if p.distance(start) > reach {
+        if !p.is_finite() || p.distance(start) > reach {
             return (start, false);
         }
-        if step.length() <= 1e-13 * reach {
+        // Settled: the step is below f64's resolution at p (or a 1e-13 of
+        // the cell's reach, whichever is larger).
+        if step.length() <= (1e-13 * reach).max(4.0 * f64::EPSILON * p.abs().max_element()) {
             return (p, true);
         }
     }
-    (p, true)
+    (start, false)
 }
 
 /// The triangle wound so that its geometric normal agrees with the mean of
@@ -306,6 +308,9 @@ fn outward(mesh: &Mesh, [a, b, c]: [u32; 3]) -> [u32; 3] {
 /// the new vertices get the analytic normal where they lie.
 fn clip_to_box(mesh: &mut Mesh, clip: &Aabb, object: &FunctionalObject) {
     let triangles = std::mem::take(&mut mesh.triangles);
+    // A cut point, computed from the edge's ends in one order, is one vertex
+    // for both triangles on the edge (so the cut leaves no crack).
+    let mut cuts: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
     for tri in triangles {
         let corners = tri.map(|i| mesh.positions[i as usize]);
         if corners.iter().all(|p| clip.contains(*p)) {
@@ -323,8 +328,11 @@ fn clip_to_box(mesh: &mut Mesh, clip: &Aabb, object: &FunctionalObject) {
                         out.push(*p);
                     }
                     if inside(p) != inside(&q) {
-                        let t = (bound - p[axis]) / (q[axis] - p[axis]);
-                        let mut x = *p + (q - *p) * t;
+                        // From the lexicographically smaller end, so that
+                        // both triangles on the edge get the same point.
+                        let (a, b) = if p.to_array() < q.to_array() { (*p, q) } else { (q, *p) };
+                        let t = (bound - a[axis]) / (b[axis] - a[axis]);
+                        let mut x = a + (b - a) * t;
                         x[axis] = bound;
                         out.push(x);
                     }
@@ -340,17 +348,25 @@ fn clip_to_box(mesh: &mut Mesh, clip: &Aabb, object: &FunctionalObject) {
         }
         // Corners of the original triangle keep their index; new points
         // become vertices.
-        let index: Vec<u32> = polygon
+        let mut index: Vec<u32> = polygon
             .iter()
             .map(|p| match corners.iter().position(|c| c == p) {
                 Some(at) => tri[at],
-                None => {
+                None => *cuts.entry(p.to_array().map(f64::to_bits)).or_insert_with(|| {
                     mesh.positions.push(*p);
                     mesh.normals.push(object.normal(*p));
                     (mesh.positions.len() - 1) as u32
-                }
+                }),
             })
             .collect();
+        // A corner on a plane gives the same point twice: one vertex.
+        index.dedup();
+        if index.len() > 1 && index[0] == index[index.len() - 1] {
+            index.pop();
+        }
+        if index.len() < 3 {
+            continue;
+        }
         for w in 1..index.len() - 1 {
             mesh.triangles.push([index[0], index[w], index[w + 1]]);
         }
@@ -371,12 +387,14 @@ fn split_seam(mesh: &mut Mesh, period: f64) {
     let mut shifted = std::collections::HashMap::new();
     for t in 0..mesh.triangles.len() {
         let tri = mesh.triangles[t];
-        let us = tri.map(|i| mesh.uvs[i as usize].x);
-        let high = us.iter().copied().fold(f64::MIN, f64::max);
-        let low = us.iter().copied().fold(f64::MAX, f64::min);
+        // A vertex on the axis has no u of its own (it gets one below).
+        let off_axis: Vec<f64> =
+            tri.iter().filter(|&&i| !on_axis(mesh.positions[i as usize])).map(|&i| mesh.uvs[i as usize].x).collect();
+        let high = off_axis.iter().copied().fold(f64::MIN, f64::max);
+        let low = off_axis.iter().copied().fold(f64::MAX, f64::min);
         if high - low > 0.5 * period {
             mesh.triangles[t] = tri.map(|i| {
-                if high - mesh.uvs[i as usize].x <= 0.5 * period {
+                if high - mesh.uvs[i as usize].x <= 0.5 * period || on_axis(mesh.positions[i as usize]) {
                     return i;
                 }
                 *shifted.entry(i).or_insert_with(|| {
@@ -564,9 +582,48 @@ mod tests {
     }
 
     #[test]
+    fn a_clipped_surface_has_no_cracks() {
+        // A sphere cut by the plane y = 0.3: every edge is shared by two
+        // triangles but those of the cut, which lie on the plane.
+        let mut object = sphere(1.0);
+        object.clip = Some(Aabb::new(DVec3::splat(-2.0), DVec3::new(2.0, 0.3, 2.0)));
+        // A planar mapping: no seam copies, so shared edges share indices.
+        let planar =
+            UvSettings { mapping: UvMapping::Planar { u_axis: DVec3::X, v_axis: DVec3::Z }, ..UvSettings::default() };
+        let (mesh, _) = tessellate(&object, &planar, 40).unwrap();
+        let mut edges = std::collections::HashMap::new();
+        for t in &mesh.triangles {
+            assert!(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "a degenerate triangle {t:?}");
+            for e in 0..3 {
+                let (a, b) = (t[e], t[(e + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let mut cut = 0;
+        for ((a, b), count) in edges {
+            if count == 1 {
+                cut += 1;
+                for v in [a, b] {
+                    assert_eq!(mesh.positions[v as usize].y, 0.3, "an open edge off the cut");
+                }
+            } else {
+                assert_eq!(count, 2);
+            }
+        }
+        assert!(cut > 40, "the cut's edges: {cut}");
+    }
+
+    #[test]
     fn the_seam_of_a_spherical_mapping_is_split() {
+        // 49 cells: vertices on the axis (the poles); 48: none.
+        for cells in [48, 49] {
+            seam_split_with(cells);
+        }
+    }
+
+    fn seam_split_with(cells: usize) {
         let uv = UvSettings { mapping: UvMapping::Spherical, scale: DVec2::new(4.0, 2.0), offset: DVec2::ZERO };
-        let (mesh, report) = tessellate(&sphere(1.0), &uv, 48).unwrap();
+        let (mesh, report) = tessellate(&sphere(1.0), &uv, cells).unwrap();
         // Within two cells of the axis (the mapping's singularity at the
         // poles, where u turns through a whole period around a point) a
         // triangle may span any u; elsewhere a fraction of a period.
@@ -585,6 +642,17 @@ mod tests {
             seam_crossings += usize::from(us.iter().any(|u| *u > 4.0));
         }
         assert!(seam_crossings > 10, "the seam's triangles were shifted by a period: {seam_crossings}");
+        // A vertex on the axis takes, in each triangle, the mean u of the
+        // other two.
+        for t in &mesh.triangles {
+            for k in 0..3 {
+                let p = mesh.positions[t[k] as usize];
+                if p.x.hypot(p.z) <= 1e-9 {
+                    let others = [t[(k + 1) % 3], t[(k + 2) % 3]].map(|i| mesh.uvs[i as usize].x);
+                    assert!((mesh.uvs[t[k] as usize].x - 0.5 * (others[0] + others[1])).abs() < 1e-12);
+                }
+            }
+        }
         assert!(pole_area < 0.01 * mesh.area(), "the poles' triangles are {pole_area} of {}", mesh.area());
     }
 
