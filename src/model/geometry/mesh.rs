@@ -84,14 +84,7 @@ impl Local<'_> {
     }
 
     fn gradient(&self, p: DVec3) -> DVec3 {
-        let mut g = self.base.gradient(p);
-        for t in &self.perturbations {
-            let q = t.quadric.eval(p);
-            if q > 0.0 {
-                g += 3.0 * t.form_factor * q * q * t.quadric.gradient(p);
-            }
-        }
-        g
+        self.perturbations.iter().fold(self.base.gradient(p), |g, t| g + t.gradient(p))
     }
 }
 

@@ -22,6 +22,16 @@ impl Perturbation {
         let q = self.quadric.eval(p).max(0.0);
         self.form_factor * q * q * q
     }
+
+    /// Its gradient 3 f Q² ∇Q (zero where Q <= 0).
+    pub fn gradient(&self, p: DVec3) -> DVec3 {
+        let q = self.quadric.eval(p);
+        if q > 0.0 {
+            3.0 * self.form_factor * q * q * self.quadric.gradient(p)
+        } else {
+            DVec3::ZERO
+        }
+    }
 }
 
 /// A base quadric with cubic perturbations, in its own (object) frame.
@@ -98,14 +108,7 @@ impl FunctionalObject {
 
     /// ∇F'(p) = ∇F + Σ 3 f_i Q_i² ∇Q_i over the perturbations with Q_i > 0.
     pub fn gradient(&self, p: DVec3) -> DVec3 {
-        let mut g = self.base.gradient(p);
-        for t in &self.perturbations {
-            let q = t.quadric.eval(p);
-            if q > 0.0 {
-                g += 3.0 * t.form_factor * q * q * t.quadric.gradient(p);
-            }
-        }
-        g
+        self.perturbations.iter().fold(self.base.gradient(p), |g, t| g + t.gradient(p))
     }
 
     /// Hessian of F' at `p`: H_F + Σ 3 f_i Q_i (2 ∇Q_i ∇Q_iᵀ + Q_i H_Qi) over
