@@ -9,14 +9,17 @@ path length, materials and lights, so that both renderers converge to the
 same image (up to the mesh's chordal error).
 
 Covered: diffuse (albedo times its map), mirror, conductor (exact complex
-Fresnel, smooth or GGX), dielectric (smooth or GGX) surfaces, nested
+Fresnel, smooth or GGX; Schlick's Fresnel with GGX up to roughness 0.2, as
+`principled`, whose separable masking differs from quadray's by 1.6e-4
+relative there at 80° from the normal: _schlick_conductor), dielectric (smooth or GGX)
+surfaces, tangent-space normal maps on any of them (`normalmap`), nested
 dielectrics (each object's outside is the smallest dielectric whose box
 holds it: water in a glass's cavity; an index-matched one is a null
 interface); point, sphere and directional lights; the uniform background;
 homogeneous media (the fog around everything, a dielectric's interior)
 with a Henyey-Greenstein phase function, for Mitsuba's `volpath`. Anything
-else (normal, roughness and displacement maps, maps on other materials,
-Schlick conductors, emissive surfaces and rect lights (quadray's emit or
+else (roughness and displacement maps, albedo maps on other materials,
+smooth or rougher Schlick conductors, emissive surfaces and rect lights (quadray's emit or
 pass light on both sides), environment maps) raises `Unsupported`: a
 comparison must not run on a scene Mitsuba would render differently.
 """
@@ -84,7 +87,7 @@ def _texture(exported, index, dir_):
 
 def _bsdf(material, exported, dir_, ext_ior=1.0):
     maps = material["maps"]
-    for key in ("normal", "roughness", "displacement"):
+    for key in ("roughness", "displacement"):
         if maps.get(key) is not None:
             raise Unsupported(f"material {material['name']}: a {key} map")
     kind = material["kind"]
@@ -110,8 +113,8 @@ def _bsdf(material, exported, dir_, ext_ior=1.0):
     if "Conductor" in kind:
         c = kind["Conductor"]
         fresnel = c["fresnel"]
-        if "Complex" not in fresnel:
-            raise Unsupported(f"material {material['name']}: a Schlick conductor")
+        if "Schlick" in fresnel:
+            return _schlick_conductor(material["name"], fresnel["Schlick"]["f0"], float(c["roughness"]))
         eta, k = fresnel["Complex"]["eta"], fresnel["Complex"]["k"]
         if c["roughness"] == 0:
             return {"type": "conductor", "eta": rgb(eta), "k": rgb(k)}
@@ -127,6 +130,72 @@ def _bsdf(material, exported, dir_, ext_ior=1.0):
         return {"type": "roughdielectric", "int_ior": float(d["ior"]), "ext_ior": ext_ior, "distribution": "ggx",
                 "alpha": float(d["roughness"]) ** 2, "sample_visible": True}
     raise Unsupported(f"material {material['name']}: kind {kind}")
+
+
+# The largest roughness at which a Schlick conductor converts (below).
+SCHLICK_MAX_ROUGHNESS = 0.2
+
+
+def _schlick_conductor(name, f0, roughness):
+    """quadray's GGX conductor with Schlick's Fresnel (F0 = `f0`) as
+    Mitsuba's `principled` with metallic 1: the same GGX distribution
+    (α = roughness²), visible-normal sampling and Schlick's Fresnel of
+    F0 = base colour at the microfacet normal. It differs in the masking:
+    Mitsuba multiplies two G1 terms (separable), quadray takes the
+    height-correlated G2 = 1 / (1 + Λ(wo) + Λ(wi)); 1/G_sep − 1/G2 =
+    Λ(wo)Λ(wi), where GGX's Λ(θ) = (√(1 + α² tan²θ) − 1)/2. At roughness 0.2
+    (α = 0.04) and 80° from the normal both ways, Λ = 0.012 and the two
+    differ by 1.6e-4 relative; at roughness 0.5, by 14 %: rougher ones, and
+    smooth ones (principled has no delta lobe), raise Unsupported."""
+    if not 0 < roughness <= SCHLICK_MAX_ROUGHNESS:
+        raise Unsupported(f"material {name}: a Schlick conductor of roughness {roughness} (converted only in "
+                          f"(0, {SCHLICK_MAX_ROUGHNESS}])")
+    return {"type": "principled", "base_color": rgb(f0), "metallic": 1.0, "roughness": roughness,
+            "specular": 0.5, "spec_tint": 0.0, "anisotropic": 0.0, "sheen": 0.0, "clearcoat": 0.0,
+            "spec_trans": 0.0}
+
+
+def _normal_mapped(bsdf, exported, index, dir_, mesh):
+    """`bsdf` under quadray's tangent-space normal map `index` on the
+    exported mesh `mesh` (Mitsuba's `normalmap`). Both read the map
+    bilinearly at level 0, decode n = 2c − 1 and normalise it, with x along
+    ∂p/∂u (made orthogonal to the normal). For y, Mitsuba takes n × ∂p/∂u,
+    quadray that vector turned towards ∂p/∂v: on a mesh whose (u, v) turn
+    the other way (the planar floor's u = x, v = z under the normal +y),
+    the map is written again with its y (green) negated."""
+    texture = _texture(exported, index, dir_)
+    if _left_handed_uv(os.path.join(dir_, mesh)):
+        path = os.path.join(dir_, f"texture-{index}-flipped-y.exr")
+        if not os.path.exists(path):
+            import numpy as np
+
+            image = np.array(mi.Bitmap(texture["filename"]))
+            image[..., 1] = 1.0 - image[..., 1]
+            mi.Bitmap(image).write(path)
+        texture = dict(texture, filename=path)
+    return {"type": "normalmap", "normalmap": texture, "bsdf": bsdf}
+
+
+def _left_handed_uv(ply):
+    """Whether n × ∂p/∂u points away from ∂p/∂v on most of the mesh's
+    triangles (per triangle, from its vertices' positions and (u, v), n the
+    mean of its vertex normals)."""
+    import numpy as np
+
+    mesh = mi.load_dict({"type": "ply", "filename": ply, "face_normals": False})
+    p = np.array(mesh.vertex_positions_buffer()).reshape(-1, 3).astype(np.float64)
+    n = np.array(mesh.vertex_normals_buffer()).reshape(-1, 3).astype(np.float64)
+    uv = np.array(mesh.vertex_texcoords_buffer()).reshape(-1, 2).astype(np.float64)
+    f = np.array(mesh.faces_buffer()).reshape(-1, 3)
+    e1, e2 = p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]
+    d1, d2 = uv[f[:, 1]] - uv[f[:, 0]], uv[f[:, 2]] - uv[f[:, 0]]
+    det = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    ok = np.abs(det) > 1e-12
+    dpdu = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2])[ok] / det[ok, None]
+    dpdv = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1])[ok] / det[ok, None]
+    normal = n[f].sum(axis=1)[ok]
+    side = np.einsum("ij,ij->i", np.cross(normal, dpdu), dpdv)
+    return np.count_nonzero(side < 0) > np.count_nonzero(side > 0)
 
 
 def _tinted(texture, albedo, dir_, index):
@@ -188,6 +257,8 @@ def mitsuba_dict(dir_, width, height, spp, seed, integrator="path"):
         parent = parents.get(i)
         ext_ior = 1.0 if parent is None else _ior(materials[objects[parent]["material"]])
         bsdf = _bsdf(material, exported, dir_, ext_ior)
+        if material["maps"].get("normal") is not None:
+            bsdf = _normal_mapped(bsdf, exported, material["maps"]["normal"], dir_, o["mesh"])
         if _ior(material) is None:
             # quadray's opaque surfaces scatter on both sides; Mitsuba's
             # only on the normal's side unless wrapped.
