@@ -162,7 +162,8 @@ def _normal_mapped(bsdf, exported, index, dir_, mesh):
     ∂p/∂u (made orthogonal to the normal). For y, Mitsuba takes n × ∂p/∂u,
     quadray that vector turned towards ∂p/∂v: on a mesh whose (u, v) turn
     the other way (the planar floor's u = x, v = z under the normal +y),
-    the map is written again with its y (green) negated."""
+    the map is written again with its y (green) negated
+    (scripts/mitsuba_normal_map_check.py checks the sign with a tilted map)."""
     texture = _texture(exported, index, dir_)
     if _left_handed_uv(os.path.join(dir_, mesh)):
         path = os.path.join(dir_, f"texture-{index}-flipped-y.exr")
