@@ -13,8 +13,10 @@ the pass budget of each quality preset, docs/presets.md) and with
 last count short of the relMSE target and the first that reaches it, it
 bisects to within an eighth of that count. quadray's time is the fastest
 measured render that reached the target (quadray_setting says which);
-quadray_flip_s likewise for Mitsuba's FLIP (the first count of the doubling
-that reaches it: an upper bound by up to 2x). quadray's own long render is
+quadray_flip_s likewise for Mitsuba's FLIP (the first count measured that
+reaches it, not bisected: an upper bound by up to 2x). One seed per count:
+where fireflies drive the relMSE, the first count below the target is
+partly luck. quadray's own long render is
 compared with the reference too ("agreement"): the error floor that the two
 renderers' differences (the mesh, texture lookups) and the reference's own
 noise leave.
@@ -195,6 +197,7 @@ def run_scene(args, scene):
         "mitsuba_flip": mitsuba_flip,
         "mitsuba_s": mitsuba_s,
         "mitsuba_runs": mitsuba_runs,
+        "mitsuba_reference_s": ref_s,
         "quadray_s": best,
         "time_ratio": None if best is None else best / mitsuba_s,
         "quadray_setting": fastest,
@@ -251,11 +254,11 @@ def main():
             lines.append(f"| {r['scene']} | not compared: {r['unsupported']} | | | | | | |")
             continue
         q, ratio, qf, ratio_f = "not reached", "", "not reached", ""
-        if r["quadray_setting"] is not None:
+        if r.get("quadray_setting") is not None:
             p = r["quadray_reached"][r["quadray_setting"]]
             q = f"{p['seconds']:.2f} ({r['quadray_setting']}, {p['spp']} spp; {p['flip']:.4f})"
             ratio = f"{r['time_ratio']:.2f}"
-        if r["quadray_flip_setting"] is not None:
+        if r.get("quadray_flip_setting") is not None:
             p = r["quadray_reached_flip"][r["quadray_flip_setting"]]
             qf = f"{p['seconds']:.2f} ({r['quadray_flip_setting']}, {p['spp']} spp)"
             ratio_f = f"{r['flip_time_ratio']:.2f}"

@@ -144,12 +144,13 @@ def _schlick_conductor(name, f0, roughness):
     Mitsuba multiplies two G1 terms (separable), quadray takes the
     height-correlated G2 = 1 / (1 + Λ(wo) + Λ(wi)); 1/G_sep − 1/G2 =
     Λ(wo)Λ(wi), where GGX's Λ(θ) = (√(1 + α² tan²θ) − 1)/2. At roughness 0.2
-    (α = 0.04) and 80° from the normal both ways, Λ = 0.012 and the two
-    differ by 1.6e-4 relative; at roughness 0.5, by 14 %: rougher ones, and
-    smooth ones (principled has no delta lobe), raise Unsupported."""
-    if not 0 < roughness <= SCHLICK_MAX_ROUGHNESS:
+    (α = 0.04) and 80° from the normal both ways, Λ = 0.013 and the two
+    differ by 1.6e-4 relative (4.5 % at 88°); at roughness 0.5 and 80°, by
+    about 8 %: rougher ones, and those quadray renders as a mirror (α below
+    1e-3; principled has no delta lobe), raise Unsupported."""
+    if not (roughness**2 >= 1e-3 and roughness <= SCHLICK_MAX_ROUGHNESS):
         raise Unsupported(f"material {name}: a Schlick conductor of roughness {roughness} (converted only in "
-                          f"(0, {SCHLICK_MAX_ROUGHNESS}])")
+                          f"[√1e-3, {SCHLICK_MAX_ROUGHNESS}])")
     return {"type": "principled", "base_color": rgb(f0), "metallic": 1.0, "roughness": roughness,
             "specular": 0.5, "spec_tint": 0.0, "anisotropic": 0.0, "sheen": 0.0, "clearcoat": 0.0,
             "spec_trans": 0.0}
@@ -166,15 +167,19 @@ def _normal_mapped(bsdf, exported, index, dir_, mesh):
     (scripts/mitsuba_normal_map_check.py checks the sign with a tilted map)."""
     texture = _texture(exported, index, dir_)
     if _left_handed_uv(os.path.join(dir_, mesh)):
-        path = os.path.join(dir_, f"texture-{index}-flipped-y.exr")
-        if not os.path.exists(path):
-            import numpy as np
+        import numpy as np
 
-            image = np.array(mi.Bitmap(texture["filename"]))
-            image[..., 1] = 1.0 - image[..., 1]
-            mi.Bitmap(image).write(path)
+        # Written each time: the export it comes from may have changed.
+        path = os.path.join(dir_, f"texture-{index}-flipped-y.exr")
+        image = np.array(mi.Bitmap(texture["filename"]))
+        image[..., 1] = 1.0 - image[..., 1]
+        mi.Bitmap(image).write(path)
         texture = dict(texture, filename=path)
-    return {"type": "normalmap", "normalmap": texture, "bsdf": bsdf}
+    # Mitsuba's defaults would darken the perturbed response by a
+    # shadowing term and turn a normal the viewer is below over; quadray
+    # does neither.
+    return {"type": "normalmap", "normalmap": texture, "bsdf": bsdf, "use_shadowing_function": False,
+            "flip_invalid_normals": False}
 
 
 def _left_handed_uv(ply):
@@ -196,7 +201,11 @@ def _left_handed_uv(ply):
     dpdv = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1])[ok] / det[ok, None]
     normal = n[f].sum(axis=1)[ok]
     side = np.einsum("ij,ij->i", np.cross(normal, dpdu), dpdv)
-    return np.count_nonzero(side < 0) > np.count_nonzero(side > 0)
+    left, right = np.count_nonzero(side < 0), np.count_nonzero(side > 0)
+    if min(left, right) > 0.01 * (left + right):
+        # quadray turns its frame per hit point; one map per mesh cannot.
+        raise Unsupported(f"{ply}: (u, v) turn both ways on one mesh ({left} and {right} triangles)")
+    return left > right
 
 
 def _tinted(texture, albedo, dir_, index):

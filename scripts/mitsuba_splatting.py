@@ -50,7 +50,8 @@ def main():
         name = os.path.splitext(os.path.basename(scene))[0]
         out = os.path.join(args.out, name)
         export = os.path.join(out, "export")
-        subprocess.run([args.quadray, "export", scene, "-o", export], check=True, capture_output=True)
+        subprocess.run([args.quadray, "export", scene, "-o", export, "--cells", "512"], check=True,
+                       capture_output=True)
         o = lambda f: os.path.join(out, f)  # noqa: E731
         row = {"scene": scene, "spp": args.spp, "reference_spp": args.ref_spp, "size": [w, h]}
         for label, rfilter in filters.items():
