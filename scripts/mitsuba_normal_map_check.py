@@ -23,7 +23,8 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(__file__))
 import mitsuba_scene  # noqa: E402
-from mitsuba_scene import arguments, compare, mitsuba_dict  # noqa: E402
+from mitsuba_scene import arguments, mitsuba_dict  # noqa: E402
+from quadray_cli import compare  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
 import numpy as np  # noqa: E402

@@ -43,14 +43,14 @@ Usage: pip install mitsuba==3.9.1 numpy; apt-get install libllvm19; cargo build 
 
 import json
 import os
-import re
 import statistics
 import subprocess
 import sys
 import time
 
 sys.path.insert(0, os.path.dirname(__file__))
-from mitsuba_scene import Unsupported, arguments, compare, mitsuba_dict  # noqa: E402
+from mitsuba_scene import Unsupported, arguments, mitsuba_dict  # noqa: E402
+from quadray_cli import compare, quadray_render  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
 
@@ -77,14 +77,6 @@ def mitsuba_render(export, path, w, h, spp, seed, integrator):
     image = mi.render(scene, spp=spp, seed=seed)
     mi.Bitmap(image).write(path)  # forces the evaluation before the clock stops
     return time.perf_counter() - start
-
-
-def quadray_render(quadray, scene, path, w, h, spp, seed, extra, log=False):
-    """quadray's GPU seconds for the render (or, with `log`, what it printed)."""
-    cmd = [quadray, "render", scene, "--width", str(w), "--height", str(h), "--spp", str(spp), "--seed",
-           str(seed), "--no-denoise", "-o", path] + extra
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stderr
-    return out if log else float(re.search(r"spp, ([0-9.]+) s on ", out).group(1))
 
 
 def side_by_side(exrs, png):

@@ -27,8 +27,6 @@ comparison must not run on a scene Mitsuba would render differently.
 import argparse
 import json
 import os
-import re
-import subprocess
 
 # Dr.Jit JIT-compiles through the system's libLLVM; Debian 12's LLVM 15
 # aborts on Mitsuba 3.9's kernels ("Cannot select: fminimum"), LLVM 19
@@ -51,19 +49,6 @@ def arguments(doc, out, width, height, ref_spp):
     ap.add_argument("--height", type=int, default=height)
     ap.add_argument("--ref-spp", type=int, default=ref_spp)
     return ap
-
-
-def compare(quadray, reference, test):
-    """relMSE on linear radiance and mean FLIP of EXR `test` against EXR
-    `reference` (`quadray compare`)."""
-    out = subprocess.run([quadray, "compare", reference, test], check=True, capture_output=True, text=True).stdout
-    flip = float(re.search(r"FLIP ([0-9.eE+-]+)", out).group(1))
-    return float(re.search(r"relative MSE ([0-9.eE+-]+)", out).group(1)), flip
-
-
-def relmse(quadray, reference, test):
-    """relMSE of EXR `test` against EXR `reference` on linear radiance."""
-    return compare(quadray, reference, test)[0]
 
 
 class Unsupported(Exception):

@@ -38,7 +38,8 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(__file__))
-from mitsuba_scene import arguments, relmse  # noqa: E402
+from mitsuba_scene import arguments  # noqa: E402
+from quadray_cli import relmse  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
 from mitsuba import ScalarTransform4f as T  # noqa: E402

@@ -25,7 +25,8 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(__file__))
-from mitsuba_scene import arguments, compare, mitsuba_dict  # noqa: E402
+from mitsuba_scene import arguments, mitsuba_dict  # noqa: E402
+from quadray_cli import compare  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
 

@@ -23,8 +23,7 @@ import shlex
 import sys
 
 sys.path.insert(0, os.path.dirname(__file__))
-from mitsuba_paper_scenes import quadray_render  # noqa: E402
-from mitsuba_scene import compare  # noqa: E402
+from quadray_cli import compare, quadray_render  # noqa: E402
 
 
 def main():
