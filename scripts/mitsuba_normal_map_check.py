@@ -23,7 +23,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(__file__))
 import mitsuba_scene  # noqa: E402
-from mitsuba_scene import arguments, mitsuba_dict  # noqa: E402
+from mitsuba_scene import arguments, mitsuba_dict, render  # noqa: E402
 from quadray_cli import compare  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
@@ -94,8 +94,8 @@ def main():
             for f in glob.glob(os.path.join(export, "texture-*-flipped-y.exr")):
                 os.remove(f)
             image = os.path.join(d, "mitsuba.exr")
-            mi.Bitmap(mi.render(mi.load_dict(mitsuba_dict(export, args.width, args.height, args.ref_spp, 3)),
-                                spp=args.ref_spp, seed=3)).write(image)
+            render(mi.load_dict(mitsuba_dict(export, args.width, args.height, args.ref_spp, 3)), image,
+                   args.ref_spp, 3)
             errors[label] = compare(args.quadray, os.path.join(d, "quadray.exr"), image)
             print(f"Mitsuba, normal map {label}: relMSE {errors[label][0]:.5f} FLIP {errors[label][1]:.4f} "
                   "against quadray", flush=True)

@@ -27,6 +27,7 @@ comparison must not run on a scene Mitsuba would render differently.
 import argparse
 import json
 import os
+import time
 
 # Dr.Jit JIT-compiles through the system's libLLVM; Debian 12's LLVM 15
 # aborts on Mitsuba 3.9's kernels ("Cannot select: fminimum"), LLVM 19
@@ -152,14 +153,11 @@ def _normal_mapped(bsdf, exported, index, dir_, mesh):
     (scripts/mitsuba_normal_map_check.py checks the sign with a tilted map)."""
     texture = _texture(exported, index, dir_)
     if _left_handed_uv(os.path.join(dir_, mesh)):
-        import numpy as np
 
-        # Written each time: the export it comes from may have changed.
-        path = os.path.join(dir_, f"texture-{index}-flipped-y.exr")
-        image = np.array(mi.Bitmap(texture["filename"]))
-        image[..., 1] = 1.0 - image[..., 1]
-        mi.Bitmap(image).write(path)
-        texture = dict(texture, filename=path)
+        def negate_y(image):
+            image[..., 1] = 1.0 - image[..., 1]
+
+        texture = _map_copy(texture, os.path.join(dir_, f"texture-{index}-flipped-y.exr"), negate_y)
     # Mitsuba's defaults would darken the perturbed response by a
     # shadowing term and turn a normal the viewer is below over; quadray
     # does neither.
@@ -194,14 +192,33 @@ def _left_handed_uv(ply):
 
 
 def _tinted(texture, albedo, dir_, index):
-    path = os.path.join(dir_, f"texture-{index}-tinted.exr")
-    if not os.path.exists(path):
-        import numpy as np
+    def tint(image):
+        image[..., :3] *= [float(a) for a in albedo]
 
-        image = np.array(mi.Bitmap(texture["filename"]))
-        image[..., :3] *= np.array(albedo, dtype=image.dtype)
-        mi.Bitmap(image).write(path)
+    return _map_copy(texture, os.path.join(dir_, f"texture-{index}-tinted.exr"), tint)
+
+
+def _map_copy(texture, path, change):
+    """`texture` read from a copy of its image at `path`, changed in place
+    by `change` (on the image as a numpy array). Written each time: the
+    export it comes from may have changed."""
+    import numpy as np
+
+    image = np.array(mi.Bitmap(texture["filename"]))
+    change(image)
+    mi.Bitmap(image).write(path)
     return dict(texture, filename=path)
+
+
+def render(scene, path, spp, seed):
+    """Renders the loaded Mitsuba scene `scene` at `spp` samples per pixel
+    with `seed` into the EXR `path`; returns the seconds of mi.render and
+    the write (which forces the evaluation before the clock stops). Mitsuba
+    combines `seed` with the seed the scene was loaded with (mitsuba_dict's
+    `seed`; its `spp` does not matter): load it with the same one."""
+    start = time.perf_counter()
+    mi.Bitmap(mi.render(scene, spp=spp, seed=seed)).write(path)
+    return time.perf_counter() - start
 
 
 def mitsuba_dict(dir_, width, height, spp, seed, integrator="path"):

@@ -35,10 +35,9 @@ import os
 import re
 import subprocess
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(__file__))
-from mitsuba_scene import arguments  # noqa: E402
+from mitsuba_scene import arguments, render  # noqa: E402
 from quadray_cli import relmse  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
@@ -103,11 +102,7 @@ def scene_dict(width, height, spp, seed):
 
 def mitsuba_render(path, width, height, spp, seed):
     """Renders to `path` (EXR) and returns the seconds mi.render took."""
-    scene = mi.load_dict(scene_dict(width, height, spp, seed))
-    start = time.perf_counter()
-    image = mi.render(scene, spp=spp, seed=seed)
-    mi.Bitmap(image).write(path)  # forces the evaluation before the clock stops
-    return time.perf_counter() - start
+    return render(mi.load_dict(scene_dict(width, height, spp, seed)), path, spp, seed)
 
 
 def quadray_render(quadray, path, width, height, spp, seed, bench=False):

@@ -25,16 +25,10 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(__file__))
-from mitsuba_scene import arguments, mitsuba_dict  # noqa: E402
-from quadray_cli import compare  # noqa: E402
+from mitsuba_scene import arguments, mitsuba_dict, render  # noqa: E402
+from quadray_cli import command_line, compare  # noqa: E402
 
 import mitsuba as mi  # noqa: E402
-
-
-def mitsuba_image(export, path, w, h, spp, seed, rfilter):
-    scene = mitsuba_dict(export, w, h, spp, seed)
-    scene["sensor"]["film"]["rfilter"] = rfilter
-    mi.Bitmap(mi.render(mi.load_dict(scene), spp=spp, seed=seed)).write(path)
 
 
 def main():
@@ -56,8 +50,10 @@ def main():
         o = lambda f: os.path.join(out, f)  # noqa: E731
         row = {"scene": scene, "spp": args.spp, "reference_spp": args.ref_spp, "size": [w, h]}
         for label, rfilter in filters.items():
-            mitsuba_image(export, o(f"reference-{label}.exr"), w, h, args.ref_spp, 1000, rfilter)
-            mitsuba_image(export, o(f"mitsuba-{label}.exr"), w, h, args.spp, 1, rfilter)
+            for spp, seed, image in [(args.ref_spp, 1000, "reference"), (args.spp, 1, "mitsuba")]:
+                scene_dict = mitsuba_dict(export, w, h, spp, seed)
+                scene_dict["sensor"]["film"]["rfilter"] = rfilter
+                render(mi.load_dict(scene_dict), o(f"{image}-{label}.exr"), spp, seed)
             row[f"mitsuba_{label}_relmse"] = compare(args.quadray, o(f"reference-{label}.exr"),
                                                      o(f"mitsuba-{label}.exr"))[0]
         subprocess.run([args.quadray, "render", scene, "--width", str(w), "--height", str(h), "--spp",
@@ -68,8 +64,7 @@ def main():
         print(f"{name}: {args.spp} spp relMSE: Mitsuba splatting (Gaussian) {row['mitsuba_gaussian_relmse']:.5f}, "
               f"Mitsuba one pixel per sample (box) {row['mitsuba_box_relmse']:.5f}, "
               f"quadray plain (jittered Gaussian) {row['quadray_relmse']:.5f}", flush=True)
-    command = "python3 scripts/mitsuba_splatting.py " + " ".join(
-        f"--{k.replace('_', '-')} {' '.join(v) if isinstance(v, list) else v}" for k, v in vars(args).items())
+    command = command_line("scripts/mitsuba_splatting.py", args)
     with open(os.path.join(args.out, "splatting.json"), "w") as f:
         json.dump({"command": command, "mitsuba": mi.__version__ + " llvm_ad_rgb", "scenes": rows}, f, indent=2)
 

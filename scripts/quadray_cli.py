@@ -22,6 +22,15 @@ def compare(quadray, reference, test):
     return float(re.search(r"relative MSE ([0-9.eE+-]+)", out).group(1)), flip
 
 
+def command_line(script, args):
+    """The command that ran `script` with the parsed `args`, every flag
+    spelled out, defaults included (a switch that is on bare, one that is
+    off left out)."""
+    flags = [f"--{k.replace('_', '-')}" + ("" if isinstance(v, bool) else f" {' '.join(v) if isinstance(v, list) else v}")
+             for k, v in vars(args).items() if v is not False]
+    return f"python3 {script} " + " ".join(flags)
+
+
 def relmse(quadray, reference, test):
     """relMSE of EXR `test` against EXR `reference` on linear radiance."""
     return compare(quadray, reference, test)[0]
