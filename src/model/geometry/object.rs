@@ -32,6 +32,18 @@ impl Perturbation {
             DVec3::ZERO
         }
     }
+
+    /// Its Hessian 3 f Q (2 ∇Q ∇Qᵀ + Q H_Q) (zero where Q <= 0).
+    pub fn hessian(&self, p: DVec3) -> DMat3 {
+        let q = self.quadric.eval(p);
+        if q > 0.0 {
+            let g = self.quadric.gradient(p);
+            let outer = DMat3::from_cols(g * g.x, g * g.y, g * g.z);
+            (outer * 2.0 + self.quadric.hessian() * q) * (3.0 * self.form_factor * q)
+        } else {
+            DMat3::ZERO
+        }
+    }
 }
 
 /// A base quadric with cubic perturbations, in its own (object) frame.
@@ -114,16 +126,7 @@ impl FunctionalObject {
     /// Hessian of F' at `p`: H_F + Σ 3 f_i Q_i (2 ∇Q_i ∇Q_iᵀ + Q_i H_Qi) over
     /// the perturbations with Q_i > 0 (the second derivative of f q³).
     pub fn hessian(&self, p: DVec3) -> DMat3 {
-        let mut h = self.base.hessian();
-        for t in &self.perturbations {
-            let q = t.quadric.eval(p);
-            if q > 0.0 {
-                let g = t.quadric.gradient(p);
-                let outer = DMat3::from_cols(g * g.x, g * g.y, g * g.z);
-                h += (outer * 2.0 + t.quadric.hessian() * q) * (3.0 * t.form_factor * q);
-            }
-        }
-        h
+        self.perturbations.iter().fold(self.base.hessian(), |h, t| h + t.hessian(p))
     }
 
     /// Mean and Gaussian curvature of the surface F' = 0 at `p`, for the
